@@ -1,0 +1,136 @@
+//! Point clouds as the pipeline sees them: f32 coordinates relative to an f64
+//! origin, so that map coordinates (UTM is ~10^6 m) keep millimetre precision.
+
+use crate::error::{Error, Result};
+use glam::{DMat4, DVec3, Vec3};
+
+/// Check that a flat buffer has a valid stride and finite x, y, z.
+pub fn check_finite(values: &[f32], stride: usize) -> Result<()> {
+    if stride != 3 && stride != 4 {
+        return Err(Error::BadStride(stride));
+    }
+    if values.len() % stride != 0 {
+        return Err(Error::BadLength {
+            len: values.len(),
+            stride,
+        });
+    }
+    for (i, p) in values.chunks_exact(stride).enumerate() {
+        if !(p[0].is_finite() && p[1].is_finite() && p[2].is_finite()) {
+            return Err(Error::NonFinite { point: i });
+        }
+    }
+    Ok(())
+}
+
+/// Check that `m` is a rigid transform: finite, orthonormal rotation with
+/// determinant +1 (tolerance 1e-4), bottom row `0 0 0 1`.
+pub fn check_rigid(m: &DMat4) -> Result<()> {
+    let a = m.to_cols_array();
+    if a.iter().any(|v| !v.is_finite()) {
+        return Err(Error::BadPose("it has a NaN or infinite entry".into()));
+    }
+    if a[3] != 0.0 || a[7] != 0.0 || a[11] != 0.0 || (a[15] - 1.0).abs() > 1e-9 {
+        return Err(Error::BadPose("its bottom row must be 0 0 0 1".into()));
+    }
+    let r = glam::DMat3::from_mat4(*m);
+    let rtr = r.transpose() * r;
+    let dev = (rtr - glam::DMat3::IDENTITY)
+        .to_cols_array()
+        .iter()
+        .fold(0.0f64, |acc, v| acc.max(v.abs()));
+    if dev > 1e-4 {
+        return Err(Error::BadPose(format!(
+            "its rotation part is not orthonormal (max |R^T R - I| = {dev:.3e}); \
+             scaling or shear is not allowed"
+        )));
+    }
+    if r.determinant() < 0.0 {
+        return Err(Error::BadPose("its rotation is a reflection (determinant -1)".into()));
+    }
+    Ok(())
+}
+
+/// A cloud in a local frame: world point `i` is `origin + points[i]`.
+#[derive(Clone, Debug, Default)]
+pub struct Cloud {
+    /// Local origin in world coordinates (metres).
+    pub origin: DVec3,
+    /// Coordinates relative to `origin` (metres).
+    pub points: Vec<Vec3>,
+}
+
+impl Cloud {
+    /// From world coordinates in f64. The origin is the centre of the bounding
+    /// box rounded to whole metres, so translated copies of a cloud get the
+    /// same local coordinates.
+    pub fn from_world_f64(points: &[DVec3]) -> Result<Self> {
+        if let Some(i) = points.iter().position(|p| !p.is_finite()) {
+            return Err(Error::NonFinite { point: i });
+        }
+        let origin = bbox_centre(points.iter().copied()).round();
+        Ok(Cloud {
+            origin,
+            points: points.iter().map(|&p| (p - origin).as_vec3()).collect(),
+        })
+    }
+
+    /// From a flat f32 buffer (stride 3 or 4), world frame.
+    pub fn from_flat(values: &[f32], stride: usize) -> Result<Self> {
+        check_finite(values, stride)?;
+        let pts: Vec<DVec3> = values
+            .chunks_exact(stride)
+            .map(|p| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
+            .collect();
+        Self::from_world_f64(&pts)
+    }
+
+    /// From a flat f32 buffer in a sensor frame and a world-from-sensor pose:
+    /// the origin is the sensor position rounded to whole metres, and each
+    /// point is transformed in f64.
+    pub fn from_sensor(values: &[f32], stride: usize, pose: &DMat4) -> Result<Self> {
+        check_finite(values, stride)?;
+        check_rigid(pose)?;
+        let origin = pose.w_axis.truncate().round();
+        let points = values
+            .chunks_exact(stride)
+            .map(|p| {
+                let w = pose.transform_point3(DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
+                (w - origin).as_vec3()
+            })
+            .collect();
+        Ok(Cloud { origin, points })
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    /// No points?
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+
+    /// World coordinates of point `i`.
+    #[inline]
+    pub fn world(&self, i: usize) -> DVec3 {
+        self.origin + self.points[i].as_dvec3()
+    }
+}
+
+fn bbox_centre(points: impl Iterator<Item = DVec3>) -> DVec3 {
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    let mut any = false;
+    for p in points {
+        lo = lo.min(p);
+        hi = hi.max(p);
+        any = true;
+    }
+    if any {
+        (lo + hi) * 0.5
+    } else {
+        DVec3::ZERO
+    }
+}

@@ -1,0 +1,365 @@
+//! Planes, local 2D frames and plane fitting from running statistics.
+
+use glam::{DVec2, DVec3};
+use serde::{Deserialize, Serialize};
+
+/// World "up" axis: near-horizontal planes get their normals pointing this way.
+pub const UP: DVec3 = DVec3::Z;
+
+/// An oriented plane `normal · x + offset = 0` (`normal` is a unit vector).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Plane {
+    /// Unit normal.
+    pub normal: DVec3,
+    /// Offset `d` in metres: `normal · x + d = 0` for points on the plane.
+    pub offset: f64,
+}
+
+impl Plane {
+    /// The plane through `point` with unit `normal`.
+    pub fn from_point_normal(point: DVec3, normal: DVec3) -> Self {
+        Plane {
+            normal,
+            offset: -normal.dot(point),
+        }
+    }
+
+    /// Signed distance in metres (positive on the normal's side).
+    #[inline]
+    pub fn signed_distance(&self, p: DVec3) -> f64 {
+        self.normal.dot(p) + self.offset
+    }
+
+    /// Angle between the two planes' normals in radians, ignoring orientation.
+    pub fn angle_to(&self, other: &Plane) -> f64 {
+        libm::acos(self.normal.dot(other.normal).abs().min(1.0))
+    }
+
+    /// Is the plane within `max_tilt` radians of horizontal?
+    pub fn is_horizontal(&self, max_tilt: f64) -> bool {
+        self.normal.dot(UP).abs() >= libm::cos(max_tilt)
+    }
+
+    /// The same plane with the normal flipped when needed so that it points
+    /// towards `viewpoint`; near-horizontal planes (within `max_tilt`) point up.
+    pub fn oriented(self, viewpoint: DVec3, max_tilt: f64) -> Self {
+        let flip = if self.is_horizontal(max_tilt) {
+            self.normal.dot(UP) < 0.0
+        } else {
+            self.signed_distance(viewpoint) < 0.0
+        };
+        if flip {
+            Plane {
+                normal: -self.normal,
+                offset: -self.offset,
+            }
+        } else {
+            self
+        }
+    }
+}
+
+/// A right-handed frame in a plane: `u × v = normal`. 2D coordinates are
+/// `(u · (p - origin), v · (p - origin))`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Frame {
+    /// Origin, on the plane, in world coordinates (metres).
+    pub origin: DVec3,
+    /// First in-plane axis (unit).
+    pub u: DVec3,
+    /// Second in-plane axis (unit).
+    pub v: DVec3,
+    /// Plane normal (unit), `u × v`.
+    pub normal: DVec3,
+}
+
+impl Frame {
+    /// A frame on `plane` with its origin at the projection of `near`.
+    ///
+    /// For walls `u` is horizontal and `v` points up along the wall; for
+    /// near-horizontal planes `u` follows the world x axis as closely as possible.
+    pub fn on_plane(plane: &Plane, near: DVec3) -> Self {
+        let n = plane.normal;
+        let origin = near - n * plane.signed_distance(near);
+        // Horizontal in-plane direction, unless the plane is (almost) horizontal.
+        let h = UP.cross(n);
+        let u = if h.length_squared() > 1e-6 {
+            h.normalize()
+        } else {
+            let x = DVec3::X - n * n.x;
+            if x.length_squared() > 1e-12 {
+                x.normalize()
+            } else {
+                (DVec3::Y - n * n.y).normalize()
+            }
+        };
+        let v = n.cross(u);
+        Frame {
+            origin,
+            u,
+            v,
+            normal: n,
+        }
+    }
+
+    /// The plane this frame lies on.
+    pub fn plane(&self) -> Plane {
+        Plane::from_point_normal(self.origin, self.normal)
+    }
+
+    /// 2D coordinates of the orthogonal projection of `p`.
+    #[inline]
+    pub fn to_local(&self, p: DVec3) -> DVec2 {
+        let d = p - self.origin;
+        DVec2::new(self.u.dot(d), self.v.dot(d))
+    }
+
+    /// World point of 2D frame coordinates.
+    #[inline]
+    pub fn to_world(&self, q: DVec2) -> DVec3 {
+        self.origin + self.u * q.x + self.v * q.y
+    }
+
+    /// This frame moved onto `plane` (a refit) with the smallest rotation, so
+    /// that 2D coordinates keep (almost) their meaning: the in-plane axes are
+    /// rotated with the normal and the origin is projected onto the new plane.
+    pub fn realigned(&self, plane: &Plane) -> Self {
+        let n = plane.normal;
+        let origin = self.origin - n * plane.signed_distance(self.origin);
+        // Gram–Schmidt: keep u as close as possible to the old u.
+        let mut u = self.u - n * n.dot(self.u);
+        if u.length_squared() < 1e-12 {
+            return Frame::on_plane(plane, self.origin);
+        }
+        u = u.normalize();
+        let v = n.cross(u);
+        Frame {
+            origin,
+            u,
+            v,
+            normal: n,
+        }
+    }
+}
+
+/// Running first and second moments of a point set, in f64, relative to a
+/// fixed reference point: constant memory, mergeable, enough for a PCA plane
+/// fit at any time. This replaces keeping every support point.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Moments {
+    /// Reference point the sums are taken relative to (world, metres).
+    pub reference: DVec3,
+    /// Number of points.
+    pub count: f64,
+    /// Sum of `p - reference`.
+    pub sum: DVec3,
+    /// Sums of products `xx, xy, xz, yy, yz, zz` of `p - reference`.
+    pub sum_sq: [f64; 6],
+}
+
+impl Moments {
+    /// No points yet, sums relative to `reference`.
+    pub fn new(reference: DVec3) -> Self {
+        Moments {
+            reference,
+            count: 0.0,
+            sum: DVec3::ZERO,
+            sum_sq: [0.0; 6],
+        }
+    }
+
+    /// Add one point.
+    #[inline]
+    pub fn push(&mut self, p: DVec3) {
+        let d = p - self.reference;
+        self.count += 1.0;
+        self.sum += d;
+        self.sum_sq[0] += d.x * d.x;
+        self.sum_sq[1] += d.x * d.y;
+        self.sum_sq[2] += d.x * d.z;
+        self.sum_sq[3] += d.y * d.y;
+        self.sum_sq[4] += d.y * d.z;
+        self.sum_sq[5] += d.z * d.z;
+    }
+
+    /// Add another set's moments (any reference point).
+    pub fn merge(&mut self, other: &Moments) {
+        if other.count == 0.0 {
+            return;
+        }
+        // Shift the other's sums to our reference: d' = d + s, s = ref_o - ref.
+        let s = other.reference - self.reference;
+        let n = other.count;
+        let so = other.sum;
+        let q = &other.sum_sq;
+        self.sum_sq[0] += q[0] + 2.0 * s.x * so.x + n * s.x * s.x;
+        self.sum_sq[1] += q[1] + s.x * so.y + s.y * so.x + n * s.x * s.y;
+        self.sum_sq[2] += q[2] + s.x * so.z + s.z * so.x + n * s.x * s.z;
+        self.sum_sq[3] += q[3] + 2.0 * s.y * so.y + n * s.y * s.y;
+        self.sum_sq[4] += q[4] + s.y * so.z + s.z * so.y + n * s.y * s.z;
+        self.sum_sq[5] += q[5] + 2.0 * s.z * so.z + n * s.z * s.z;
+        self.sum += so + s * n;
+        self.count += n;
+    }
+
+    /// Mean of the points (world).
+    pub fn mean(&self) -> DVec3 {
+        if self.count == 0.0 {
+            self.reference
+        } else {
+            self.reference + self.sum / self.count
+        }
+    }
+
+    /// Covariance matrix (row-major symmetric 3x3) about the mean.
+    pub fn covariance(&self) -> [[f64; 3]; 3] {
+        if self.count == 0.0 {
+            return [[0.0; 3]; 3];
+        }
+        let n = self.count;
+        let m = self.sum / n;
+        let q = &self.sum_sq;
+        let xx = q[0] / n - m.x * m.x;
+        let xy = q[1] / n - m.x * m.y;
+        let xz = q[2] / n - m.x * m.z;
+        let yy = q[3] / n - m.y * m.y;
+        let yz = q[4] / n - m.y * m.z;
+        let zz = q[5] / n - m.z * m.z;
+        [[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]]
+    }
+
+    /// Least-squares plane (PCA: normal along the smallest eigenvector of the
+    /// covariance) and its eigenvalues in ascending order. `None` for fewer
+    /// than three points or a degenerate (collinear or single-point) set.
+    pub fn fit_plane(&self) -> Option<(Plane, [f64; 3])> {
+        if self.count < 3.0 {
+            return None;
+        }
+        let (vals, vecs) = symmetric_eigen3(self.covariance());
+        // Collinear (second eigenvalue ~ 0) or all identical: no unique plane.
+        let scale = vals[2].max(1e-300);
+        if vals[1] <= 1e-12 * scale || vals[2] <= 0.0 {
+            return None;
+        }
+        let n = vecs[0];
+        let len = n.length();
+        if !len.is_finite() || len < 0.5 {
+            return None;
+        }
+        Some((Plane::from_point_normal(self.mean(), n / len), vals))
+    }
+}
+
+/// Eigen-decomposition of a symmetric 3x3 matrix by cyclic Jacobi rotations.
+/// Returns eigenvalues ascending and the matching unit eigenvectors.
+pub fn symmetric_eigen3(m: [[f64; 3]; 3]) -> ([f64; 3], [DVec3; 3]) {
+    let mut a = m;
+    let mut v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    for _sweep in 0..32 {
+        let off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
+        let diag = a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2];
+        if off <= 1e-30 * diag || off == 0.0 {
+            break;
+        }
+        for (p, q) in [(0usize, 1usize), (0, 2), (1, 2)] {
+            if a[p][q] == 0.0 {
+                continue;
+            }
+            let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+            let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+            let t = if theta == 0.0 { 1.0 } else { t };
+            let c = 1.0 / (t * t + 1.0).sqrt();
+            let s = t * c;
+            for k in 0..3 {
+                let akp = a[k][p];
+                let akq = a[k][q];
+                a[k][p] = c * akp - s * akq;
+                a[k][q] = s * akp + c * akq;
+            }
+            for k in 0..3 {
+                let apk = a[p][k];
+                let aqk = a[q][k];
+                a[p][k] = c * apk - s * aqk;
+                a[q][k] = s * apk + c * aqk;
+            }
+            for row in v.iter_mut() {
+                let vkp = row[p];
+                let vkq = row[q];
+                row[p] = c * vkp - s * vkq;
+                row[q] = s * vkp + c * vkq;
+            }
+        }
+    }
+    let mut idx = [0usize, 1, 2];
+    idx.sort_by(|&i, &j| a[i][i].total_cmp(&a[j][j]));
+    let vals = [a[idx[0]][idx[0]], a[idx[1]][idx[1]], a[idx[2]][idx[2]]];
+    let col = |j: usize| DVec3::new(v[0][j], v[1][j], v[2][j]);
+    (vals, [col(idx[0]), col(idx[1]), col(idx[2])])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pca_recovers_a_tilted_plane_far_from_origin() {
+        let n = DVec3::new(0.3, -0.2, 0.9).normalize();
+        let base = DVec3::new(500_000.0, 4_500_000.0, 50.0);
+        let f = Frame::on_plane(&Plane::from_point_normal(base, n), base);
+        let mut m = Moments::new(base.round());
+        for i in 0..20 {
+            for j in 0..20 {
+                m.push(f.to_world(DVec2::new(i as f64 * 0.5, j as f64 * 0.3)));
+            }
+        }
+        let (p, vals) = m.fit_plane().unwrap();
+        assert!(p.normal.dot(n).abs() > 1.0 - 1e-12);
+        assert!(p.signed_distance(base).abs() < 1e-6);
+        assert!(vals[0].abs() < 1e-9);
+    }
+
+    #[test]
+    fn merge_equals_pushing_everything() {
+        let pts: Vec<DVec3> = (0..50)
+            .map(|i| DVec3::new(i as f64 * 0.7, (i * i % 13) as f64, (i % 5) as f64 * 0.1))
+            .collect();
+        let mut all = Moments::new(DVec3::ZERO);
+        pts.iter().for_each(|&p| all.push(p));
+        let mut a = Moments::new(DVec3::new(3.0, 1.0, 0.0));
+        let mut b = Moments::new(DVec3::new(-10.0, 5.0, 2.0));
+        pts[..20].iter().for_each(|&p| a.push(p));
+        pts[20..].iter().for_each(|&p| b.push(p));
+        a.merge(&b);
+        let (ca, cb) = (a.covariance(), all.covariance());
+        for i in 0..3 {
+            for j in 0..3 {
+                assert!((ca[i][j] - cb[i][j]).abs() < 1e-9);
+            }
+        }
+        assert!((a.mean() - all.mean()).length() < 1e-12);
+    }
+
+    #[test]
+    fn degenerate_sets_have_no_plane() {
+        let mut m = Moments::new(DVec3::ZERO);
+        for i in 0..10 {
+            m.push(DVec3::new(i as f64, 2.0 * i as f64, 0.0));
+        }
+        assert!(m.fit_plane().is_none(), "collinear");
+        let mut m = Moments::new(DVec3::ZERO);
+        for _ in 0..10 {
+            m.push(DVec3::ONE);
+        }
+        assert!(m.fit_plane().is_none(), "identical");
+    }
+
+    #[test]
+    fn frames_are_right_handed_and_round_trip() {
+        for n in [DVec3::Z, -DVec3::Z, DVec3::X, DVec3::new(1.0, 1.0, 0.2).normalize()] {
+            let f = Frame::on_plane(&Plane::from_point_normal(DVec3::ONE, n), DVec3::ZERO);
+            assert!((f.u.cross(f.v) - n).length() < 1e-12);
+            let q = DVec2::new(1.5, -2.0);
+            assert!((f.to_local(f.to_world(q)) - q).length() < 1e-12);
+        }
+    }
+}

@@ -1,0 +1,404 @@
+//! Simple polygons in 2D (a ring of vertices, no repeated closing vertex) and
+//! planar polygons in 3D.
+
+use super::plane::{Frame, Plane};
+use glam::{DVec2, DVec3};
+use serde::{Deserialize, Serialize};
+
+/// The signed area (positive when counter-clockwise).
+pub fn signed_area(ring: &[DVec2]) -> f64 {
+    let n = ring.len();
+    if n < 3 {
+        return 0.0;
+    }
+    let mut s = 0.0;
+    for i in 0..n {
+        let a = ring[i];
+        let b = ring[(i + 1) % n];
+        s += a.x * b.y - a.y * b.x;
+    }
+    0.5 * s
+}
+
+/// Orientation of the triangle `a, b, c`: > 0 counter-clockwise.
+#[inline]
+pub fn orient(a: DVec2, b: DVec2, c: DVec2) -> f64 {
+    (b - a).perp_dot(c - a)
+}
+
+/// Squared distance from `p` to the segment `a b`.
+#[inline]
+pub fn segment_distance_sq(p: DVec2, a: DVec2, b: DVec2) -> f64 {
+    let ab = b - a;
+    let len2 = ab.length_squared();
+    let t = if len2 > 0.0 {
+        ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (a + ab * t - p).length_squared()
+}
+
+/// Is `p` strictly inside the ring (even-odd rule)? Points exactly on an edge
+/// may go either way; use [`distance`] for a tolerance.
+pub fn contains(ring: &[DVec2], p: DVec2) -> bool {
+    let n = ring.len();
+    if n < 3 {
+        return false;
+    }
+    let mut inside = false;
+    let mut j = n - 1;
+    for i in 0..n {
+        let (a, b) = (ring[i], ring[j]);
+        if (a.y > p.y) != (b.y > p.y) {
+            let x = a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y);
+            if p.x < x {
+                inside = !inside;
+            }
+        }
+        j = i;
+    }
+    inside
+}
+
+/// Distance from `p` to the ring's boundary.
+pub fn boundary_distance(ring: &[DVec2], p: DVec2) -> f64 {
+    let n = ring.len();
+    let mut best = f64::INFINITY;
+    for i in 0..n {
+        best = best.min(segment_distance_sq(p, ring[i], ring[(i + 1) % n]));
+    }
+    best.sqrt()
+}
+
+/// Distance from `p` to the polygon region: 0 inside, else to the boundary.
+pub fn distance(ring: &[DVec2], p: DVec2) -> f64 {
+    if ring.is_empty() {
+        return f64::INFINITY;
+    }
+    if contains(ring, p) {
+        0.0
+    } else {
+        boundary_distance(ring, p)
+    }
+}
+
+/// Do the closed segments `a b` and `c d` intersect (touching counts)?
+pub fn segments_intersect(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> bool {
+    let d1 = orient(c, d, a);
+    let d2 = orient(c, d, b);
+    let d3 = orient(a, b, c);
+    let d4 = orient(a, b, d);
+    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
+        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
+    {
+        return true;
+    }
+    let on = |p: DVec2, q: DVec2, r: DVec2| {
+        r.x >= p.x.min(q.x) && r.x <= p.x.max(q.x) && r.y >= p.y.min(q.y) && r.y <= p.y.max(q.y)
+    };
+    (d1 == 0.0 && on(c, d, a))
+        || (d2 == 0.0 && on(c, d, b))
+        || (d3 == 0.0 && on(a, b, c))
+        || (d4 == 0.0 && on(a, b, d))
+}
+
+/// Is the ring a simple polygon: at least three distinct vertices, non-zero
+/// area, and no two non-adjacent edges touching? O(n^2); rings here are short.
+pub fn is_simple(ring: &[DVec2]) -> bool {
+    let n = ring.len();
+    if n < 3 || signed_area(ring).abs() <= 0.0 {
+        return false;
+    }
+    if ring.iter().any(|p| !p.is_finite()) {
+        return false;
+    }
+    for i in 0..n {
+        let (a, b) = (ring[i], ring[(i + 1) % n]);
+        if a == b {
+            return false;
+        }
+        for j in (i + 1)..n {
+            let adjacent = j == i + 1 || (i == 0 && j == n - 1);
+            let (c, d) = (ring[j], ring[(j + 1) % n]);
+            if adjacent {
+                // Adjacent edges share one vertex; they must not fold back.
+                let (shared, p, q) = if j == i + 1 { (b, a, d) } else { (a, b, c) };
+                if orient(p, shared, q) == 0.0 && (p - shared).dot(q - shared) > 0.0 {
+                    return false;
+                }
+                continue;
+            }
+            if segments_intersect(a, b, c, d) {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+/// Make the ring counter-clockwise (reversing it if needed).
+pub fn make_ccw(ring: &mut [DVec2]) {
+    if signed_area(ring) < 0.0 {
+        ring.reverse();
+    }
+}
+
+/// Remove consecutive duplicates and vertices on a straight line between
+/// their neighbours.
+pub fn remove_collinear(ring: &mut Vec<DVec2>) {
+    let mut changed = true;
+    while changed && ring.len() > 3 {
+        changed = false;
+        let n = ring.len();
+        let mut out = Vec::with_capacity(n);
+        for i in 0..n {
+            let prev = ring[(i + n - 1) % n];
+            let cur = ring[i];
+            let next = ring[(i + 1) % n];
+            let scale = (next - prev).length_squared().max(1e-300);
+            if cur == prev || orient(prev, cur, next).abs() <= 1e-12 * scale {
+                changed = true;
+                continue;
+            }
+            out.push(cur);
+        }
+        if out.len() < 3 {
+            return;
+        }
+        *ring = out;
+    }
+}
+
+/// Douglas–Peucker simplification of a closed ring within `tolerance` metres
+/// that never returns a non-simple ring: if the simplified ring self-intersects,
+/// the tolerance is halved until it does not (the input, if simple, is the
+/// last resort). Also enforces at most `max_vertices` by raising the tolerance.
+pub fn simplify(ring: &[DVec2], tolerance: f64, max_vertices: usize) -> Vec<DVec2> {
+    let n = ring.len();
+    if n <= 4 {
+        return ring.to_vec();
+    }
+    let max_vertices = max_vertices.max(4);
+    let mut tol = tolerance.max(0.0);
+    // Raise the tolerance until the vertex cap is met.
+    let mut out = dp_closed(ring, tol);
+    let mut guard = 0;
+    while out.len() > max_vertices && guard < 60 {
+        tol = if tol > 0.0 { tol * 1.5 } else { 1e-3 };
+        out = dp_closed(ring, tol);
+        guard += 1;
+    }
+    // Lower it until the result is simple.
+    let mut guard = 0;
+    while !is_simple(&out) && guard < 40 {
+        tol *= 0.5;
+        out = dp_closed(ring, tol);
+        guard += 1;
+    }
+    if is_simple(&out) {
+        out
+    } else {
+        ring.to_vec()
+    }
+}
+
+fn dp_closed(ring: &[DVec2], tol: f64) -> Vec<DVec2> {
+    let n = ring.len();
+    // Split at the two mutually farthest-ish vertices: vertex 0 and the one
+    // farthest from it.
+    let far = (1..n)
+        .max_by(|&i, &j| {
+            (ring[i] - ring[0])
+                .length_squared()
+                .total_cmp(&(ring[j] - ring[0]).length_squared())
+        })
+        .unwrap_or(n / 2);
+    let mut keep = vec![false; n];
+    keep[0] = true;
+    keep[far] = true;
+    let tol2 = tol * tol;
+    let mut stack = vec![(0usize, far), (far, n)];
+    while let Some((s, e)) = stack.pop() {
+        if e <= s + 1 {
+            continue;
+        }
+        let (a, b) = (ring[s], ring[e % n]);
+        let mut best = (0.0, 0usize);
+        for (i, &p) in ring.iter().enumerate().take(e).skip(s + 1) {
+            let d = segment_distance_sq(p, a, b);
+            if d > best.0 {
+                best = (d, i);
+            }
+        }
+        if best.0 > tol2 {
+            keep[best.1] = true;
+            stack.push((s, best.1));
+            stack.push((best.1, e));
+        }
+    }
+    ring.iter()
+        .zip(keep)
+        .filter_map(|(&p, k)| k.then_some(p))
+        .collect()
+}
+
+/// Smallest distance between the boundaries of two rings, or 0 when they
+/// overlap (one contains a vertex of the other, or edges cross).
+pub fn ring_distance(a: &[DVec2], b: &[DVec2]) -> f64 {
+    if a.len() < 3 || b.len() < 3 {
+        return f64::INFINITY;
+    }
+    if contains(a, b[0]) || contains(b, a[0]) {
+        return 0.0;
+    }
+    let mut best = f64::INFINITY;
+    for i in 0..a.len() {
+        let (p, q) = (a[i], a[(i + 1) % a.len()]);
+        for j in 0..b.len() {
+            let (r, s) = (b[j], b[(j + 1) % b.len()]);
+            if segments_intersect(p, q, r, s) {
+                return 0.0;
+            }
+            best = best
+                .min(segment_distance_sq(p, r, s))
+                .min(segment_distance_sq(q, r, s))
+                .min(segment_distance_sq(r, p, q))
+                .min(segment_distance_sq(s, p, q));
+        }
+    }
+    best.sqrt()
+}
+
+/// A planar polygon in 3D: a frame on its plane and a simple counter-clockwise
+/// ring in that frame's 2D coordinates (so it is counter-clockwise seen from
+/// the normal side).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Polygon3 {
+    /// Frame on the polygon's plane.
+    pub frame: Frame,
+    /// Outline in frame coordinates (metres), counter-clockwise.
+    pub ring: Vec<DVec2>,
+}
+
+impl Polygon3 {
+    /// Build from world vertices in outline order. The normal comes from
+    /// Newell's method (so it follows the vertex order: counter-clockwise seen
+    /// from the normal side). `None` for fewer than three vertices or zero area.
+    pub fn from_world(vertices: &[DVec3]) -> Option<Self> {
+        let n = vertices.len();
+        if n < 3 || vertices.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        let c = vertices.iter().copied().sum::<DVec3>() / n as f64;
+        let mut normal = DVec3::ZERO;
+        for i in 0..n {
+            let a = vertices[i] - c;
+            let b = vertices[(i + 1) % n] - c;
+            normal += a.cross(b);
+        }
+        let len = normal.length();
+        if len <= 0.0 || !len.is_finite() {
+            return None;
+        }
+        let plane = Plane::from_point_normal(c, normal / len);
+        let frame = Frame::on_plane(&plane, c);
+        let ring: Vec<DVec2> = vertices.iter().map(|&v| frame.to_local(v)).collect();
+        Some(Polygon3 { frame, ring })
+    }
+
+    /// The support plane.
+    pub fn plane(&self) -> Plane {
+        self.frame.plane()
+    }
+
+    /// Outline vertices in world coordinates, in order.
+    pub fn vertices(&self) -> Vec<DVec3> {
+        self.ring.iter().map(|&q| self.frame.to_world(q)).collect()
+    }
+
+    /// Area in square metres.
+    pub fn area(&self) -> f64 {
+        signed_area(&self.ring).abs()
+    }
+
+    /// Exact Euclidean distance from a world point to the polygon (a flat
+    /// region including its interior).
+    pub fn distance(&self, p: DVec3) -> f64 {
+        let h = self.frame.plane().signed_distance(p);
+        let d = distance(&self.ring, self.frame.to_local(p));
+        (h * h + d * d).sqrt()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square(s: f64) -> Vec<DVec2> {
+        vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(s, 0.0),
+            DVec2::new(s, s),
+            DVec2::new(0.0, s),
+        ]
+    }
+
+    #[test]
+    fn area_contains_distance() {
+        let sq = square(2.0);
+        assert_eq!(signed_area(&sq), 4.0);
+        assert!(contains(&sq, DVec2::new(1.0, 1.0)));
+        assert!(!contains(&sq, DVec2::new(3.0, 1.0)));
+        assert_eq!(distance(&sq, DVec2::new(1.0, 1.0)), 0.0);
+        assert!((distance(&sq, DVec2::new(3.0, 1.0)) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn simplicity() {
+        assert!(is_simple(&square(1.0)));
+        let bowtie = vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(1.0, 1.0),
+            DVec2::new(1.0, 0.0),
+            DVec2::new(0.0, 1.0),
+        ];
+        assert!(!is_simple(&bowtie));
+        assert!(!is_simple(&[DVec2::ZERO, DVec2::X, DVec2::X * 2.0]));
+    }
+
+    #[test]
+    fn simplify_keeps_shape_and_simplicity() {
+        // A noisy circle.
+        let ring: Vec<DVec2> = (0..400)
+            .map(|i| {
+                let t = i as f64 / 400.0 * std::f64::consts::TAU;
+                let r = 10.0 + 0.01 * ((i * 7919) % 13) as f64;
+                DVec2::new(r * libm::cos(t), r * libm::sin(t))
+            })
+            .collect();
+        let s = simplify(&ring, 0.05, 64);
+        assert!(s.len() <= 64 && s.len() >= 8, "{}", s.len());
+        assert!(is_simple(&s));
+        assert!((signed_area(&s) - signed_area(&ring)).abs() / signed_area(&ring) < 0.02);
+    }
+
+    #[test]
+    fn polygon3_distance_and_orientation() {
+        let verts = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(0.0, 4.0, 0.0),
+            DVec3::new(0.0, 4.0, 3.0),
+            DVec3::new(0.0, 0.0, 3.0),
+        ];
+        let p = Polygon3::from_world(&verts).unwrap();
+        assert!((p.plane().normal - DVec3::X).length() < 1e-12);
+        assert!(signed_area(&p.ring) > 0.0);
+        assert!((p.area() - 12.0).abs() < 1e-9);
+        assert!((p.distance(DVec3::new(0.5, 1.0, 1.0)) - 0.5).abs() < 1e-12);
+        assert!((p.distance(DVec3::new(0.0, 7.0, 7.0)) - 5.0).abs() < 1e-9);
+        for (a, b) in p.vertices().iter().zip(&verts) {
+            assert!((*a - *b).length() < 1e-9);
+        }
+    }
+}

@@ -1,0 +1,16 @@
+//! # polyscene
+//!
+//! Incremental maps of large planar polygons (road, sidewalks, facades, walls,
+//! vehicle sides) from a stream of LiDAR scans, after Oliveira et al.,
+//! "Incremental scenario representations for autonomous driving using
+//! geometric polygonal primitives" (Robotics and Autonomous Systems, 2016).
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod cloud;
+pub mod error;
+pub mod geometry;
+pub mod io;
+pub mod rng;
+
+pub use error::{Error, Result};
