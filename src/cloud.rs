@@ -46,7 +46,9 @@ pub fn check_rigid(m: &DMat4) -> Result<()> {
         )));
     }
     if r.determinant() < 0.0 {
-        return Err(Error::BadPose("its rotation is a reflection (determinant -1)".into()));
+        return Err(Error::BadPose(
+            "its rotation is a reflection (determinant -1)".into(),
+        ));
     }
     Ok(())
 }

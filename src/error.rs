@@ -45,7 +45,10 @@ impl fmt::Display for Error {
                  (expected interleaved x, y, z{} values)",
                 if *stride == 4 { ", intensity" } else { "" }
             ),
-            Error::BadStride(s) => write!(f, "stride must be 3 (x, y, z) or 4 (x, y, z, intensity), got {s}"),
+            Error::BadStride(s) => write!(
+                f,
+                "stride must be 3 (x, y, z) or 4 (x, y, z, intensity), got {s}"
+            ),
             Error::NonFinite { point } => {
                 write!(f, "point {point} has a NaN or infinite coordinate")
             }

@@ -145,6 +145,9 @@ mod tests {
         assert_eq!(decode_f32(&bytes, 4).unwrap(), vec![1.0, 2.0, 3.0, 0.5]);
         assert!(decode_f32(&bytes[..12], 4).is_err());
         bytes[0..4].copy_from_slice(&f32::NAN.to_le_bytes());
-        assert!(matches!(decode_f32(&bytes, 4), Err(Error::NonFinite { point: 0 })));
+        assert!(matches!(
+            decode_f32(&bytes, 4),
+            Err(Error::NonFinite { point: 0 })
+        ));
     }
 }

@@ -7,10 +7,17 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod cli;
+pub mod clock;
 pub mod cloud;
+pub mod detect;
 pub mod error;
+pub mod eval;
 pub mod geometry;
+pub mod hash;
 pub mod io;
+pub mod params;
+pub mod primitive;
 pub mod rng;
 
 pub use error::{Error, Result};

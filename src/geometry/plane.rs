@@ -355,7 +355,12 @@ mod tests {
 
     #[test]
     fn frames_are_right_handed_and_round_trip() {
-        for n in [DVec3::Z, -DVec3::Z, DVec3::X, DVec3::new(1.0, 1.0, 0.2).normalize()] {
+        for n in [
+            DVec3::Z,
+            -DVec3::Z,
+            DVec3::X,
+            DVec3::new(1.0, 1.0, 0.2).normalize(),
+        ] {
             let f = Frame::on_plane(&Plane::from_point_normal(DVec3::ONE, n), DVec3::ZERO);
             assert!((f.u.cross(f.v) - n).length() < 1e-12);
             let q = DVec2::new(1.5, -2.0);

@@ -1,0 +1,209 @@
+//! One-shot detection of planar polygons: the paper's Algorithm 1, a cascade
+//! of RANSAC plane search, Euclidean clustering, PCA refit, outline and
+//! acceptance tests, each round removing what it explained.
+
+pub mod cluster;
+pub mod ransac;
+
+use crate::clock;
+use crate::cloud::Cloud;
+use crate::error::Result;
+use crate::geometry::{Frame, Plane};
+use crate::params::Params;
+use crate::primitive::{shape, Primitive};
+use crate::rng::Rng;
+use glam::{DVec2, DVec3, Vec3};
+use ransac::PlanePool;
+use serde::Serialize;
+
+/// Label of a point that no primitive explains.
+pub const NO_PRIMITIVE: u32 = u32::MAX;
+
+/// One round of the cascade (for the paper's Fig. 9 analysis).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(rename_all = "camelCase")]
+pub struct CascadeStep {
+    /// Points still in play before this round.
+    pub points_left: usize,
+    /// RANSAC inliers of the round's best plane.
+    pub inliers: usize,
+    /// Points in the largest cluster of those inliers.
+    pub cluster: usize,
+    /// Whether a primitive was accepted.
+    pub accepted: bool,
+    /// Outline area of the candidate (m^2; 0 when it had no outline).
+    pub area: f64,
+    /// Wall time of the round (ms).
+    pub time_ms: f64,
+}
+
+/// What one detection found.
+#[derive(Clone, Debug)]
+pub struct Detection {
+    /// Accepted primitives, in the order found (ids 0, 1, ...).
+    pub primitives: Vec<Primitive>,
+    /// Per input point: the index of the primitive it supports, or
+    /// [`NO_PRIMITIVE`].
+    pub labels: Vec<u32>,
+    /// The cascade, round by round.
+    pub steps: Vec<CascadeStep>,
+    /// Point-to-plane distance evaluations spent.
+    pub work: u64,
+    /// Wall time (ms).
+    pub time_ms: f64,
+}
+
+/// Detect planar polygons in a world-frame cloud. Normals of non-horizontal
+/// planes point towards the cloud's centroid (the sensor side, for street
+/// scans); use [`Detector::run`] to give another viewpoint.
+///
+/// ```
+/// use polyscene::{cloud::Cloud, detect::detect, params::Params};
+/// // A 10 m x 10 m floor sampled every 10 cm.
+/// let mut pts = Vec::new();
+/// for i in 0..100 {
+///     for j in 0..100 {
+///         pts.extend_from_slice(&[i as f32 * 0.1, j as f32 * 0.1, 0.0]);
+///     }
+/// }
+/// let cloud = Cloud::from_flat(&pts, 3).unwrap();
+/// let found = detect(&cloud, &Params::gpp2()).unwrap();
+/// assert_eq!(found.primitives.len(), 1);
+/// assert!((found.primitives[0].area - 99.0).abs() < 3.0);
+/// ```
+pub fn detect(cloud: &Cloud, params: &Params) -> Result<Detection> {
+    params.validate()?;
+    let mut c = DVec3::ZERO;
+    for p in &cloud.points {
+        c += p.as_dvec3();
+    }
+    let viewpoint = cloud.origin + c / cloud.len().max(1) as f64;
+    Ok(Detector::new(params).run(&cloud.points, cloud.origin, viewpoint))
+}
+
+/// The detection cascade with its parameters (validated by the caller).
+pub struct Detector<'p> {
+    params: &'p Params,
+}
+
+impl<'p> Detector<'p> {
+    /// A detector with these parameters.
+    pub fn new(params: &'p Params) -> Self {
+        Detector { params }
+    }
+
+    /// Run the cascade on `pts` (local coordinates relative to `origin`).
+    /// `viewpoint` (world) decides which way non-horizontal normals point.
+    pub fn run(&self, pts: &[Vec3], origin: DVec3, viewpoint: DVec3) -> Detection {
+        let p = self.params;
+        let t0 = clock::now_ms();
+        let mut pool = PlanePool::new(pts, p.sample_radius, Rng::new(p.seed));
+        let mut labels = vec![NO_PRIMITIVE; pts.len()];
+        let mut primitives: Vec<Primitive> = Vec::new();
+        let mut steps = Vec::new();
+        let max_rounds = 4 * p.max_primitives + 64;
+        let mut rejections = 0;
+        for _ in 0..max_rounds {
+            if primitives.len() >= p.max_primitives
+                || pool.work >= p.max_work
+                || rejections >= p.max_rejections
+            {
+                break;
+            }
+            let ts = clock::now_ms();
+            let points_left = pool.remaining();
+            // 1. RANSAC: the plane with the largest consensus, or stop.
+            let Some((plane, inliers)) = pool.best_plane(p) else {
+                break;
+            };
+            // 2. Cluster the inliers in the plane; the largest cluster is the support.
+            let local = Plane {
+                normal: plane.normal,
+                offset: plane.offset,
+            };
+            let frame = Frame::on_plane(&local, pts[inliers[0] as usize].as_dvec3());
+            let flat: Vec<DVec2> = inliers
+                .iter()
+                .map(|&i| frame.to_local(pts[i as usize].as_dvec3()))
+                .collect();
+            let (comp, sizes) = cluster::clusters(&flat, p.cluster_tolerance);
+            let largest = comp
+                .iter()
+                .copied()
+                .reduce(|b, c| {
+                    if sizes[c as usize] > sizes[b as usize] {
+                        c
+                    } else {
+                        b
+                    }
+                })
+                .unwrap_or(0);
+            if (sizes[largest as usize] as usize) < p.min_inliers {
+                // No connected patch of this plane is large enough to be a
+                // primitive: its inliers are scattered clutter (a plane slicing
+                // through trees and cars). Take them all out of play at once
+                // rather than one fragment per round.
+                pool.remove(&inliers);
+                steps.push(CascadeStep {
+                    points_left,
+                    inliers: inliers.len(),
+                    cluster: sizes[largest as usize] as usize,
+                    accepted: false,
+                    area: 0.0,
+                    time_ms: clock::now_ms() - ts,
+                });
+                rejections += 1;
+                continue;
+            }
+            let cluster: Vec<u32> = (0..comp.len())
+                .filter(|&c| comp[c] == largest)
+                .map(|c| inliers[c])
+                .collect();
+            let support_pts: Vec<Vec3> = cluster.iter().map(|&i| pts[i as usize]).collect();
+            // 3-4. PCA refit, frame, outline, area and solidity.
+            let shaped = shape(origin, &support_pts, p, viewpoint);
+            // 5. Accept when large and solid enough.
+            let mut step = CascadeStep {
+                points_left,
+                inliers: inliers.len(),
+                cluster: cluster.len(),
+                accepted: false,
+                area: shaped.as_ref().map_or(0.0, |s| s.primitive.area),
+                time_ms: 0.0,
+            };
+            // 6. Take the support out of play (the whole cluster when rejected).
+            match shaped {
+                Some(s) if s.primitive.acceptable(p) => {
+                    let id = primitives.len() as u32;
+                    let taken: Vec<u32> = cluster
+                        .iter()
+                        .zip(&s.kept)
+                        .filter_map(|(&i, &k)| k.then_some(i))
+                        .collect();
+                    for &i in &taken {
+                        labels[i as usize] = id;
+                    }
+                    pool.remove(&taken);
+                    let mut prim = s.primitive;
+                    prim.id = id;
+                    primitives.push(prim);
+                    step.accepted = true;
+                    rejections = 0;
+                }
+                _ => {
+                    pool.remove(&cluster);
+                    rejections += 1;
+                }
+            }
+            step.time_ms = clock::now_ms() - ts;
+            steps.push(step);
+        }
+        Detection {
+            primitives,
+            labels,
+            steps,
+            work: pool.work,
+            time_ms: clock::now_ms() - t0,
+        }
+    }
+}

@@ -1,0 +1,638 @@
+//! Occupancy rasters on a plane and concave outlines traced from them.
+//!
+//! A [`Footprint`] is a bit grid in a primitive's 2D frame: a cell is set when
+//! a support point fell in it. It is what a primitive remembers of *where* it
+//! was observed, in memory proportional to its extent (not to its points), and
+//! it grows with every scan.
+//!
+//! The concave outline is a discrete alpha hull: the occupied cells are closed
+//! morphologically with a disk of radius `alpha` (dilate, then erode: this is
+//! exactly the complement of the union of all empty disks of radius `alpha`,
+//! i.e. the alpha hull, on the grid), the largest 4-connected region is kept,
+//! its holes are filled, and its boundary is traced along cell edges. A
+//! hole-free 4-connected region of cells has no pinch vertices, so the traced
+//! ring is always a simple polygon; it is then simplified (Douglas–Peucker,
+//! simplicity kept) within a tolerance. Work is linear in the number of cells
+//! in the bounding box, independent of the number of points.
+
+use super::polygon::{is_simple, make_ccw, remove_collinear, simplify};
+use glam::DVec2;
+use serde::{Deserialize, Serialize};
+
+/// Most cells the outline tracer works on at once: a larger footprint is
+/// traced at a coarser resolution (cells merged 2x2 until it fits).
+pub const MAX_TRACE_CELLS: usize = 4_000_000;
+
+/// A growable occupancy bit grid in a plane's 2D frame.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Footprint {
+    cell: f64,
+    x0: i64,
+    y0: i64,
+    w: usize,
+    h: usize,
+    bits: Vec<u64>,
+}
+
+impl Footprint {
+    /// Empty footprint with square cells of `cell` metres (clamped to >= 1 mm).
+    pub fn new(cell: f64) -> Self {
+        let cell = if cell.is_finite() {
+            cell.max(1e-3)
+        } else {
+            0.2
+        };
+        Footprint {
+            cell,
+            x0: 0,
+            y0: 0,
+            w: 0,
+            h: 0,
+            bits: Vec::new(),
+        }
+    }
+
+    /// Cell size in metres.
+    pub fn cell(&self) -> f64 {
+        self.cell
+    }
+
+    #[inline]
+    fn index_of(&self, p: DVec2) -> (i64, i64) {
+        (
+            libm::floor(p.x / self.cell) as i64,
+            libm::floor(p.y / self.cell) as i64,
+        )
+    }
+
+    fn grow_to(&mut self, lo: (i64, i64), hi: (i64, i64)) {
+        if self.w > 0
+            && lo.0 >= self.x0
+            && lo.1 >= self.y0
+            && hi.0 < self.x0 + self.w as i64
+            && hi.1 < self.y0 + self.h as i64
+        {
+            return;
+        }
+        let (mut nx0, mut ny0, mut nx1, mut ny1) = (lo.0, lo.1, hi.0 + 1, hi.1 + 1);
+        if self.w > 0 {
+            nx0 = nx0.min(self.x0);
+            ny0 = ny0.min(self.y0);
+            nx1 = nx1.max(self.x0 + self.w as i64);
+            ny1 = ny1.max(self.y0 + self.h as i64);
+            // Amortise: leave a quarter of the size as slack on the growing sides.
+            let (sx, sy) = ((nx1 - nx0) / 4 + 4, (ny1 - ny0) / 4 + 4);
+            if lo.0 < self.x0 {
+                nx0 -= sx;
+            }
+            if hi.0 >= self.x0 + self.w as i64 {
+                nx1 += sx;
+            }
+            if lo.1 < self.y0 {
+                ny0 -= sy;
+            }
+            if hi.1 >= self.y0 + self.h as i64 {
+                ny1 += sy;
+            }
+        }
+        let (nw, nh) = ((nx1 - nx0) as usize, (ny1 - ny0) as usize);
+        let mut bits = vec![0u64; (nw * nh).div_ceil(64)];
+        for y in 0..self.h {
+            for x in 0..self.w {
+                if self.get_local(x, y) {
+                    let gx = (self.x0 + x as i64 - nx0) as usize;
+                    let gy = (self.y0 + y as i64 - ny0) as usize;
+                    let k = gy * nw + gx;
+                    bits[k >> 6] |= 1 << (k & 63);
+                }
+            }
+        }
+        *self = Footprint {
+            cell: self.cell,
+            x0: nx0,
+            y0: ny0,
+            w: nw,
+            h: nh,
+            bits,
+        };
+    }
+
+    #[inline]
+    fn get_local(&self, x: usize, y: usize) -> bool {
+        let k = y * self.w + x;
+        self.bits[k >> 6] >> (k & 63) & 1 == 1
+    }
+
+    /// Is the cell containing `p` set?
+    pub fn is_set(&self, p: DVec2) -> bool {
+        let (ix, iy) = self.index_of(p);
+        let (x, y) = (ix - self.x0, iy - self.y0);
+        x >= 0
+            && y >= 0
+            && (x as usize) < self.w
+            && (y as usize) < self.h
+            && self.get_local(x as usize, y as usize)
+    }
+
+    /// Set the cells of all `points` (frame coordinates, metres). Non-finite
+    /// points are ignored.
+    pub fn mark_all(&mut self, points: &[DVec2]) {
+        let mut lo = (i64::MAX, i64::MAX);
+        let mut hi = (i64::MIN, i64::MIN);
+        for &p in points {
+            if !p.is_finite() {
+                continue;
+            }
+            let (x, y) = self.index_of(p);
+            lo = (lo.0.min(x), lo.1.min(y));
+            hi = (hi.0.max(x), hi.1.max(y));
+        }
+        if lo.0 > hi.0 {
+            return;
+        }
+        self.grow_to(lo, hi);
+        for &p in points {
+            if !p.is_finite() {
+                continue;
+            }
+            let (x, y) = self.index_of(p);
+            let k = (y - self.y0) as usize * self.w + (x - self.x0) as usize;
+            self.bits[k >> 6] |= 1 << (k & 63);
+        }
+    }
+
+    /// Number of set cells.
+    pub fn count(&self) -> usize {
+        self.bits.iter().map(|b| b.count_ones() as usize).sum()
+    }
+
+    /// Area of the set cells in square metres.
+    pub fn occupied_area(&self) -> f64 {
+        self.count() as f64 * self.cell * self.cell
+    }
+
+    /// Centres of the set cells (frame coordinates), in row-major order.
+    pub fn cell_centres(&self) -> Vec<DVec2> {
+        let mut out = Vec::new();
+        for y in 0..self.h {
+            for x in 0..self.w {
+                if self.get_local(x, y) {
+                    out.push(self.centre(self.x0 + x as i64, self.y0 + y as i64));
+                }
+            }
+        }
+        out
+    }
+
+    fn centre(&self, ix: i64, iy: i64) -> DVec2 {
+        DVec2::new((ix as f64 + 0.5) * self.cell, (iy as f64 + 0.5) * self.cell)
+    }
+
+    /// Bytes held by the grid.
+    pub fn heap_bytes(&self) -> usize {
+        self.bits.len() * 8
+    }
+
+    /// Concave outline (see the module docs): closing radius `alpha` metres,
+    /// simplification `tolerance` metres, at most `max_vertices` vertices.
+    /// Counter-clockwise, simple; `None` when nothing is set.
+    pub fn outline(&self, alpha: f64, tolerance: f64, max_vertices: usize) -> Option<Vec<DVec2>> {
+        self.outline_region(alpha, tolerance, max_vertices)
+            .map(|(r, _)| r)
+    }
+
+    /// [`Footprint::outline`] together with the raster region it traces, to
+    /// test which points the outline was made from.
+    pub fn outline_region(
+        &self,
+        alpha: f64,
+        tolerance: f64,
+        max_vertices: usize,
+    ) -> Option<(Vec<DVec2>, Region)> {
+        if self.count() == 0 {
+            return None;
+        }
+        // Work grid: the occupied bounding box plus a margin for the closing,
+        // coarsened until it fits the cell budget.
+        let (mut lx, mut ly, mut hx, mut hy) = (usize::MAX, usize::MAX, 0, 0);
+        for y in 0..self.h {
+            for x in 0..self.w {
+                if self.get_local(x, y) {
+                    lx = lx.min(x);
+                    ly = ly.min(y);
+                    hx = hx.max(x);
+                    hy = hy.max(y);
+                }
+            }
+        }
+        let mut factor = 1usize;
+        loop {
+            let r = ((alpha.max(0.0) / (self.cell * factor as f64)).ceil() as usize).min(4096);
+            let m = r + 2;
+            let gw = (hx - lx) / factor + 1 + 2 * m;
+            let gh = (hy - ly) / factor + 1 + 2 * m;
+            if gw * gh > MAX_TRACE_CELLS && factor < 1 << 12 {
+                factor *= 2;
+                continue;
+            }
+            let mut grid = vec![false; gw * gh];
+            for y in ly..=hy {
+                for x in lx..=hx {
+                    if self.get_local(x, y) {
+                        grid[((y - ly) / factor + m) * gw + (x - lx) / factor + m] = true;
+                    }
+                }
+            }
+            let (corners, inside) = trace_region(grid, gw, gh, r)?;
+            let cs = self.cell * factor as f64;
+            let ox = (self.x0 + lx as i64) as f64 * self.cell - m as f64 * cs;
+            let oy = (self.y0 + ly as i64) as f64 * self.cell - m as f64 * cs;
+            let region = Region {
+                cell: self.cell,
+                base: (self.x0 + lx as i64, self.y0 + ly as i64),
+                factor: factor as i64,
+                margin: m as i64,
+                w: gw,
+                h: gh,
+                inside,
+            };
+            let mut ring: Vec<DVec2> = corners
+                .into_iter()
+                .map(|(x, y)| DVec2::new(ox + x as f64 * cs, oy + y as f64 * cs))
+                .collect();
+            make_ccw(&mut ring);
+            remove_collinear(&mut ring);
+            if ring.len() < 3 {
+                return None;
+            }
+            // The traced ring runs along the outer edges of the boundary cells,
+            // half a cell beyond the points on average: move it in by half a
+            // cell (through the boundary cells' centres), unless that would
+            // collapse a one-cell-wide part.
+            let inset = inset_rectilinear(&ring, 0.5 * cs);
+            if is_simple(&inset) {
+                ring = inset;
+            }
+            let mut out = simplify(&ring, tolerance.max(0.0), max_vertices);
+            make_ccw(&mut out);
+            return Some((out, region));
+        }
+    }
+
+    /// Copy another footprint's set cells into this one, mapping each set
+    /// cell centre through `map` (used when merging primitives with different
+    /// frames).
+    pub fn merge_mapped(&mut self, other: &Footprint, map: impl Fn(DVec2) -> DVec2) {
+        let pts: Vec<DVec2> = other.cell_centres().into_iter().map(map).collect();
+        self.mark_all(&pts);
+    }
+}
+
+/// The raster region a concave outline was traced from (before
+/// simplification): the outline is within the simplification tolerance of
+/// this region's boundary.
+#[derive(Clone, Debug)]
+pub struct Region {
+    cell: f64,
+    base: (i64, i64),
+    factor: i64,
+    margin: i64,
+    w: usize,
+    h: usize,
+    inside: Vec<bool>,
+}
+
+impl Region {
+    /// Does the footprint cell under `p` belong to the region? Uses the
+    /// footprint's own cell indexing, so it agrees exactly with `mark_all`.
+    pub fn contains(&self, p: DVec2) -> bool {
+        let ix = libm::floor(p.x / self.cell) as i64;
+        let iy = libm::floor(p.y / self.cell) as i64;
+        let x = (ix - self.base.0).div_euclid(self.factor) + self.margin;
+        let y = (iy - self.base.1).div_euclid(self.factor) + self.margin;
+        x >= 0
+            && y >= 0
+            && (x as usize) < self.w
+            && (y as usize) < self.h
+            && self.inside[y as usize * self.w + x as usize]
+    }
+}
+
+/// Offset a counter-clockwise rectilinear ring inwards by `d` (each edge
+/// moves along its left normal; vertices move along the miter).
+fn inset_rectilinear(ring: &[DVec2], d: f64) -> Vec<DVec2> {
+    let n = ring.len();
+    let left = |e: DVec2| DVec2::new(-e.y, e.x);
+    (0..n)
+        .map(|i| {
+            let prev = ring[(i + n - 1) % n];
+            let cur = ring[i];
+            let next = ring[(i + 1) % n];
+            let a = left((cur - prev).normalize_or_zero());
+            let b = left((next - cur).normalize_or_zero());
+            cur + (a + b) * d
+        })
+        .collect()
+}
+
+/// Close `grid` with a disk of radius `r` cells, keep the largest 4-connected
+/// region, fill its holes and trace its outer boundary along cell edges.
+/// Returns the ring in grid-corner coordinates and the region's cells.
+fn trace_region(
+    grid: Vec<bool>,
+    w: usize,
+    h: usize,
+    r: usize,
+) -> Option<(Vec<(i64, i64)>, Vec<bool>)> {
+    let closed = if r > 0 {
+        let r2 = (r * r) as f64;
+        let dil: Vec<bool> = sq_edt(&grid, w, h).into_iter().map(|d| d <= r2).collect();
+        let outside: Vec<bool> = dil.iter().map(|&b| !b).collect();
+        sq_edt(&outside, w, h)
+            .into_iter()
+            .map(|d| d > r2)
+            .collect::<Vec<bool>>()
+    } else {
+        grid
+    };
+    // Largest 4-connected region (first found wins ties: row-major order).
+    let mut label = vec![0u32; w * h];
+    let (mut best, mut best_size, mut next) = (0u32, 0usize, 1u32);
+    let mut stack = Vec::new();
+    for start in 0..w * h {
+        if !closed[start] || label[start] != 0 {
+            continue;
+        }
+        let mut size = 0;
+        label[start] = next;
+        stack.push(start);
+        while let Some(k) = stack.pop() {
+            size += 1;
+            for nb in neighbours4(k, w, h) {
+                if closed[nb] && label[nb] == 0 {
+                    label[nb] = next;
+                    stack.push(nb);
+                }
+            }
+        }
+        if size > best_size {
+            best_size = size;
+            best = next;
+        }
+        next += 1;
+    }
+    if best_size == 0 {
+        return None;
+    }
+    // Fill holes: everything not reachable from the border through
+    // non-region cells belongs to the region.
+    let mut outside = vec![false; w * h];
+    for k in 0..w * h {
+        let (x, y) = (k % w, k / w);
+        if (x == 0 || y == 0 || x == w - 1 || y == h - 1) && label[k] != best && !outside[k] {
+            outside[k] = true;
+            stack.push(k);
+            while let Some(j) = stack.pop() {
+                for nb in neighbours4(j, w, h) {
+                    if label[nb] != best && !outside[nb] {
+                        outside[nb] = true;
+                        stack.push(nb);
+                    }
+                }
+            }
+        }
+    }
+    let inside = |x: i64, y: i64| -> bool {
+        x >= 0
+            && y >= 0
+            && (x as usize) < w
+            && (y as usize) < h
+            && !outside[y as usize * w + x as usize]
+    };
+    // Directed boundary edges with the region on the left; from each corner
+    // exactly one leaves (no pinches), keyed by its start corner.
+    let mut next_of: Vec<u32> = vec![u32::MAX; (w + 1) * (h + 1)];
+    let cid = |x: i64, y: i64| y as usize * (w + 1) + x as usize;
+    let mut first = None;
+    for y in 0..h as i64 {
+        for x in 0..w as i64 {
+            if !inside(x, y) {
+                continue;
+            }
+            // bottom edge (region above): left to right
+            if !inside(x, y - 1) {
+                next_of[cid(x, y)] = cid(x + 1, y) as u32;
+                first.get_or_insert(cid(x, y));
+            }
+            // right edge: bottom to top
+            if !inside(x + 1, y) {
+                next_of[cid(x + 1, y)] = cid(x + 1, y + 1) as u32;
+            }
+            // top edge: right to left
+            if !inside(x, y + 1) {
+                next_of[cid(x + 1, y + 1)] = cid(x, y + 1) as u32;
+            }
+            // left edge: top to bottom
+            if !inside(x - 1, y) {
+                next_of[cid(x, y + 1)] = cid(x, y) as u32;
+            }
+        }
+    }
+    let start = first?;
+    let mut ring = Vec::new();
+    let mut c = start;
+    let limit = 4 * w * h + 4;
+    loop {
+        ring.push(((c % (w + 1)) as i64, (c / (w + 1)) as i64));
+        let n = next_of[c];
+        if n == u32::MAX || ring.len() > limit {
+            return None;
+        }
+        c = n as usize;
+        if c == start {
+            break;
+        }
+    }
+    let inside_mask = outside.into_iter().map(|o| !o).collect();
+    Some((ring, inside_mask))
+}
+
+fn neighbours4(k: usize, w: usize, h: usize) -> impl Iterator<Item = usize> {
+    let (x, y) = (k % w, k / w);
+    [
+        (x > 0).then(|| k - 1),
+        (x + 1 < w).then(|| k + 1),
+        (y > 0).then(|| k - w),
+        (y + 1 < h).then(|| k + w),
+    ]
+    .into_iter()
+    .flatten()
+}
+
+/// Exact squared Euclidean distance (in cells) from every cell to the nearest
+/// set cell (Felzenszwalb–Huttenlocher, separable, linear time).
+fn sq_edt(grid: &[bool], w: usize, h: usize) -> Vec<f64> {
+    const INF: f64 = 1e20;
+    let mut d: Vec<f64> = grid.iter().map(|&b| if b { 0.0 } else { INF }).collect();
+    let n = w.max(h);
+    let (mut f, mut out, mut v, mut z) = (
+        vec![0.0; n],
+        vec![0.0; n],
+        vec![0usize; n],
+        vec![0.0; n + 1],
+    );
+    for x in 0..w {
+        for y in 0..h {
+            f[y] = d[y * w + x];
+        }
+        edt_1d(&f[..h], &mut out[..h], &mut v, &mut z);
+        for y in 0..h {
+            d[y * w + x] = out[y];
+        }
+    }
+    for y in 0..h {
+        f[..w].copy_from_slice(&d[y * w..(y + 1) * w]);
+        edt_1d(&f[..w], &mut out[..w], &mut v, &mut z);
+        d[y * w..(y + 1) * w].copy_from_slice(&out[..w]);
+    }
+    d
+}
+
+fn edt_1d(f: &[f64], out: &mut [f64], v: &mut [usize], z: &mut [f64]) {
+    let n = f.len();
+    if n == 0 {
+        return;
+    }
+    let mut k = 0usize;
+    v[0] = 0;
+    z[0] = f64::NEG_INFINITY;
+    z[1] = f64::INFINITY;
+    for q in 1..n {
+        let mut s;
+        loop {
+            let p = v[k];
+            s = ((f[q] + (q * q) as f64) - (f[p] + (p * p) as f64)) / (2.0 * (q as f64 - p as f64));
+            if s <= z[k] && k > 0 {
+                k -= 1;
+            } else {
+                break;
+            }
+        }
+        if s <= z[k] {
+            // k == 0 and the new parabola dominates from the start.
+            v[0] = q;
+            z[0] = f64::NEG_INFINITY;
+            z[1] = f64::INFINITY;
+            continue;
+        }
+        k += 1;
+        v[k] = q;
+        z[k] = s;
+        z[k + 1] = f64::INFINITY;
+    }
+    k = 0;
+    for (q, o) in out.iter_mut().enumerate() {
+        while z[k + 1] < q as f64 {
+            k += 1;
+        }
+        let p = v[k];
+        let dq = q as f64 - p as f64;
+        *o = dq * dq + f[p];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::polygon::{contains, is_simple, signed_area};
+
+    fn grid_points(f: impl Fn(f64, f64) -> bool, step: f64, n: usize) -> Vec<DVec2> {
+        let mut v = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                let p = DVec2::new((i as f64 + 0.5) * step, (j as f64 + 0.5) * step);
+                if f(p.x, p.y) {
+                    v.push(p);
+                }
+            }
+        }
+        v
+    }
+
+    #[test]
+    fn edt_matches_brute_force() {
+        let (w, h) = (13, 9);
+        let grid: Vec<bool> = (0..w * h).map(|k| k % 7 == 0 || k == 50).collect();
+        let d = sq_edt(&grid, w, h);
+        for k in 0..w * h {
+            let (x, y) = ((k % w) as f64, (k / w) as f64);
+            let best = (0..w * h)
+                .filter(|&j| grid[j])
+                .map(|j| {
+                    let (a, b) = ((j % w) as f64, (j / w) as f64);
+                    (a - x) * (a - x) + (b - y) * (b - y)
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert_eq!(d[k], best);
+        }
+    }
+
+    #[test]
+    fn l_shape_outline_leaves_the_missing_corner_out() {
+        // L: 10 x 10 square minus the [5,10] x [5,10] quadrant.
+        let pts = grid_points(|x, y| !(x > 5.0 && y > 5.0), 0.1, 101);
+        let mut fp = Footprint::new(0.1);
+        fp.mark_all(&pts);
+        let ring = fp.outline(0.3, 0.05, 200).unwrap();
+        assert!(is_simple(&ring));
+        assert!(signed_area(&ring) > 0.0);
+        assert!(
+            !contains(&ring, DVec2::new(8.0, 8.0)),
+            "missing corner covered"
+        );
+        assert!(contains(&ring, DVec2::new(2.0, 8.0)));
+        let a = signed_area(&ring);
+        assert!((a - 75.0).abs() < 3.0, "area {a}");
+        assert!(ring.len() <= 12, "{} vertices", ring.len());
+    }
+
+    #[test]
+    fn closing_bridges_gaps_narrower_than_two_alpha() {
+        // Two strips 0.6 m apart: alpha 0.4 joins them, alpha 0.2 does not.
+        let pts = grid_points(|_, y| y < 2.0 || y > 2.6, 0.05, 100);
+        let mut fp = Footprint::new(0.05);
+        fp.mark_all(&pts);
+        let joined = fp.outline(0.4, 0.02, 100).unwrap();
+        assert!(contains(&joined, DVec2::new(2.0, 2.3)));
+        let split = fp.outline(0.2, 0.02, 100).unwrap();
+        assert!(!contains(&split, DVec2::new(2.0, 2.3)));
+        assert!(is_simple(&split));
+    }
+
+    #[test]
+    fn holes_are_filled_and_growth_keeps_cells() {
+        let ring_pts = grid_points(|x, y| !(x > 3.0 && x < 6.0 && y > 3.0 && y < 6.0), 0.1, 91);
+        let mut fp = Footprint::new(0.1);
+        fp.mark_all(&ring_pts[..ring_pts.len() / 2]);
+        let before = fp.count();
+        fp.mark_all(&ring_pts[ring_pts.len() / 2..]);
+        assert!(fp.count() > before);
+        assert!(fp.is_set(DVec2::new(0.05, 0.05)));
+        let o = fp.outline(0.0, 0.0, 1000).unwrap();
+        assert!(contains(&o, DVec2::new(4.5, 4.5)), "hole not filled");
+        assert!(is_simple(&o));
+    }
+
+    #[test]
+    fn diagonal_touching_cells_never_make_a_pinch() {
+        // A checkerboard: every outline must still be simple.
+        let pts = grid_points(|x, y| ((x as i64) + (y as i64)) % 2 == 0, 1.0, 9);
+        let mut fp = Footprint::new(1.0);
+        fp.mark_all(&pts);
+        for alpha in [0.0, 0.5, 1.0, 2.0] {
+            if let Some(o) = fp.outline(alpha, 0.0, 1000) {
+                assert!(is_simple(&o), "alpha {alpha}");
+            }
+        }
+    }
+}

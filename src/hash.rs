@@ -1,0 +1,59 @@
+//! A small deterministic hasher for integer grid keys (the std default is
+//! randomly seeded and slower). Maps built with it are only ever looked up,
+//! never iterated to produce results, so output does not depend on it.
+
+use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
+
+/// Multiply-rotate hasher for fixed-size integer keys.
+#[derive(Default, Clone, Copy)]
+pub struct GridHasher(u64);
+
+impl Hasher for GridHasher {
+    #[inline]
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    #[inline]
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(b as u64);
+        }
+    }
+    #[inline]
+    fn write_u64(&mut self, v: u64) {
+        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x51_7C_C1_B7_27_22_0A_95);
+    }
+    #[inline]
+    fn write_i64(&mut self, v: i64) {
+        self.write_u64(v as u64);
+    }
+    #[inline]
+    fn write_u32(&mut self, v: u32) {
+        self.write_u64(v as u64);
+    }
+    #[inline]
+    fn write_i32(&mut self, v: i32) {
+        self.write_u64(v as u32 as u64);
+    }
+    #[inline]
+    fn write_usize(&mut self, v: usize) {
+        self.write_u64(v as u64);
+    }
+}
+
+/// `HashMap` with [`GridHasher`].
+pub type GridMap<K, V> = HashMap<K, V, BuildHasherDefault<GridHasher>>;
+
+/// Pack a 3D cell index into one key.
+#[inline]
+pub fn key3(x: i64, y: i64, z: i64) -> u64 {
+    let m = (1u64 << 21) - 1;
+    ((x as u64) & m) | (((y as u64) & m) << 21) | (((z as u64) & m) << 42)
+}
+
+/// Pack a 2D cell index into one key.
+#[inline]
+pub fn key2(x: i64, y: i64) -> u64 {
+    ((x as u64) & 0xFFFF_FFFF) | ((y as u64) << 32)
+}

@@ -1,0 +1,357 @@
+//! The one parameter set of the pipeline, with units and defaults, and the
+//! paper's two configurations as presets.
+//!
+//! The paper names its two configurations GPP 1 ("only very large polygons,
+//! faster") and GPP 2 ("small polygons too"). The authors' public code uses
+//! RANSAC distances of 0.3 m (ground) and 0.2 m (other planes), a Euclidean
+//! cluster tolerance of 0.9 m, acceptance above 7 m^2 and 48 points/m^2, and
+//! expansion steps of 15 m along / 0.3 m across for the ground and 0.2 m along
+//! / 0.5 m across for other primitives. Those values were tuned for 2007-era
+//! HDL-64E data; the defaults here were re-measured on the simulated HDL-64E
+//! scans and the real Ouster scans (see BENCHMARKS.md), and every departure is
+//! noted on its field.
+
+use crate::error::{Error, Result};
+use serde::{Deserialize, Serialize};
+
+/// How a primitive's outline is computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum HullKind {
+    /// 2D convex hull of the support (the paper's default). Over-covers
+    /// L-shaped and partly occluded surfaces.
+    Convex,
+    /// Discrete alpha hull of the support's occupancy raster: follows
+    /// concavities wider than `2 * alpha`. Always a simple polygon.
+    Concave,
+}
+
+/// How "solidity", the paper's second acceptance test, is measured.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SolidityKind {
+    /// Support points per square metre of polygon (what the authors' code
+    /// does). Depends on range and sensor: a wall at 50 m has far fewer
+    /// points per m^2 than one at 10 m.
+    Density,
+    /// Share of the polygon's area whose raster cells hold a support point.
+    /// Scale-free as long as the point spacing is below the cell size.
+    Occupancy,
+}
+
+/// Every tunable of detection and expansion. Distances in metres, areas in
+/// square metres, angles in degrees.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase", deny_unknown_fields, default)]
+pub struct Params {
+    // --- RANSAC plane search ---
+    /// Inlier distance to a plane for non-ground planes (m). Default 0.10
+    /// (authors: 0.2, for noisier data; 0.2 swallows curbs and door recesses).
+    pub distance: f64,
+    /// Inlier distance for near-horizontal (ground) planes (m). Default 0.12
+    /// (authors: 0.3; that merges the road with 0.15 m high sidewalks).
+    pub ground_distance: f64,
+    /// Largest tilt from horizontal for a plane to count as ground (deg).
+    /// Default 15.
+    pub ground_max_tilt: f64,
+    /// Fewest inliers a plane needs, and fewest support points a primitive
+    /// needs; the cascade stops when the best plane has fewer. gpp2 default
+    /// 150, gpp1 400.
+    pub min_inliers: usize,
+    /// Most plane hypotheses drawn per primitive (a bound on work). Default 400.
+    pub max_hypotheses: usize,
+    /// Confidence that the best plane was sampled, for the adaptive stop
+    /// (0..1). Default 0.995.
+    pub confidence: f64,
+    /// Radius of the neighbourhood the 2nd and 3rd sample points are drawn
+    /// from (m). Default 1.0.
+    pub sample_radius: f64,
+    /// Seed of the random generator; same seed, same result. Default 7.
+    pub seed: u64,
+
+    // --- Clustering ---
+    /// Euclidean clustering tolerance (m): inliers closer than this (measured
+    /// in the plane) are connected. Default 0.5 (authors: 0.9).
+    pub cluster_tolerance: f64,
+
+    // --- Outline ---
+    /// Convex or concave outlines. Default concave.
+    pub hull: HullKind,
+    /// Concave outline radius for non-ground primitives (m): gaps and notches
+    /// narrower than `2 * alpha` are filled. Default 0.5.
+    pub alpha: f64,
+    /// Concave outline radius for ground primitives (m); the ground is seen
+    /// at grazing angles with wide gaps between laser rings. Default 1.5.
+    pub ground_alpha: f64,
+    /// Raster cell size of footprints (m): the resolution of concave
+    /// outlines and of the occupancy test. Default 0.2.
+    pub cell: f64,
+    /// Outline simplification tolerance (m). Default 0.1.
+    pub simplify: f64,
+    /// Most vertices of an outline (the tolerance is raised to meet it).
+    /// Default 64.
+    pub max_vertices: usize,
+
+    // --- Acceptance ---
+    /// Smallest polygon area accepted (m^2), the paper's A_t. gpp2 default
+    /// 1.5, gpp1 7 (authors).
+    pub min_area: f64,
+    /// Smallest width of a polygon (m), across its narrowest direction:
+    /// rejects the thin strips a plane cuts out of a crossing surface.
+    /// Default 0.4.
+    pub min_width: f64,
+    /// Which solidity test to apply. Default occupancy.
+    pub solidity: SolidityKind,
+    /// Least support points per m^2 with `solidity: density`. Default 48
+    /// (authors).
+    pub min_density: f64,
+    /// Least occupied share of the area with `solidity: occupancy` (0..1).
+    /// Default 0.3.
+    pub min_occupancy: f64,
+
+    // --- Cascade budget ---
+    /// Most primitives one detection returns. Default 200.
+    pub max_primitives: usize,
+    /// The cascade stops after this many rounds in a row found nothing
+    /// acceptable (what is left is clutter). Default 24.
+    pub max_rejections: usize,
+    /// Work budget of one detection, in point-to-plane distance evaluations
+    /// (about a nanosecond each natively). Default 2e9.
+    pub max_work: u64,
+
+    // --- Expansion (incremental update) ---
+    /// Grow existing primitives with each scan before detecting new ones.
+    /// Default true; false gives the paper's "without expansion" mode.
+    pub expansion: bool,
+    /// Perpendicular gate of expansion, ground (m). Default 0.15 (authors 0.3).
+    pub ground_expand_across: f64,
+    /// Longitudinal growth reach per step, ground (m). Default 2.0 (authors
+    /// 15, with a convex hull; with connectivity-based growth a smaller
+    /// reach avoids jumping onto unrelated surfaces at the same height).
+    pub ground_expand_along: f64,
+    /// Perpendicular gate of expansion, other primitives (m). Default 0.12
+    /// (authors 0.5).
+    pub expand_across: f64,
+    /// Longitudinal growth reach per step, other primitives (m). Default 0.6
+    /// (authors 0.2).
+    pub expand_along: f64,
+    /// Largest angle between two primitives' planes for a merge (deg).
+    /// Default 8.
+    pub merge_angle: f64,
+    /// Largest plane-to-plane distance for a merge (m). Default 0.12.
+    pub merge_distance: f64,
+    /// Outlines closer than this are "touching" for a merge (m). Default 0.3.
+    pub merge_gap: f64,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Params::gpp2()
+    }
+}
+
+impl Params {
+    /// The paper's GPP 2: small polygons too, more accurate, slower.
+    pub fn gpp2() -> Self {
+        Params {
+            distance: 0.10,
+            ground_distance: 0.12,
+            ground_max_tilt: 15.0,
+            min_inliers: 150,
+            max_hypotheses: 400,
+            confidence: 0.995,
+            sample_radius: 1.0,
+            seed: 7,
+            cluster_tolerance: 0.5,
+            hull: HullKind::Concave,
+            alpha: 0.5,
+            ground_alpha: 1.5,
+            cell: 0.2,
+            simplify: 0.1,
+            max_vertices: 64,
+            min_area: 1.5,
+            min_width: 0.4,
+            solidity: SolidityKind::Occupancy,
+            min_density: 48.0,
+            min_occupancy: 0.3,
+            max_primitives: 200,
+            max_rejections: 24,
+            max_work: 2_000_000_000,
+            expansion: true,
+            ground_expand_across: 0.15,
+            ground_expand_along: 2.0,
+            expand_across: 0.12,
+            expand_along: 0.6,
+            merge_angle: 8.0,
+            merge_distance: 0.12,
+            merge_gap: 0.3,
+        }
+    }
+
+    /// The paper's GPP 1: only large polygons (A_t = 7 m^2), faster.
+    pub fn gpp1() -> Self {
+        Params {
+            min_inliers: 400,
+            min_area: 7.0,
+            max_primitives: 60,
+            ..Params::gpp2()
+        }
+    }
+
+    /// A preset by name: `"gpp1"` or `"gpp2"`.
+    pub fn preset(name: &str) -> Result<Self> {
+        match name {
+            "gpp1" => Ok(Params::gpp1()),
+            "gpp2" => Ok(Params::gpp2()),
+            other => Err(Error::BadOption {
+                key: "preset".into(),
+                reason: format!("unknown preset '{other}', expected 'gpp1' or 'gpp2'"),
+            }),
+        }
+    }
+
+    /// Check every field's range; the error names the offending key (in the
+    /// camelCase spelling the JS options use).
+    pub fn validate(&self) -> Result<()> {
+        fn pos(key: &str, v: f64, max: f64) -> Result<()> {
+            if !(v.is_finite() && v > 0.0 && v <= max) {
+                return Err(Error::BadOption {
+                    key: key.into(),
+                    reason: format!("must be a number in (0, {max}], got {v}"),
+                });
+            }
+            Ok(())
+        }
+        fn frac(key: &str, v: f64, lo_open: bool) -> Result<()> {
+            let ok = v.is_finite() && v <= 1.0 && if lo_open { v > 0.0 } else { v >= 0.0 };
+            if !ok {
+                return Err(Error::BadOption {
+                    key: key.into(),
+                    reason: format!("must be a number between 0 and 1, got {v}"),
+                });
+            }
+            Ok(())
+        }
+        fn count(key: &str, v: usize, lo: usize, hi: usize) -> Result<()> {
+            if v < lo || v > hi {
+                return Err(Error::BadOption {
+                    key: key.into(),
+                    reason: format!("must be an integer in [{lo}, {hi}], got {v}"),
+                });
+            }
+            Ok(())
+        }
+        pos("distance", self.distance, 100.0)?;
+        pos("groundDistance", self.ground_distance, 100.0)?;
+        if !(self.ground_max_tilt.is_finite() && (0.0..=90.0).contains(&self.ground_max_tilt)) {
+            return Err(Error::BadOption {
+                key: "groundMaxTilt".into(),
+                reason: format!("must be in [0, 90] degrees, got {}", self.ground_max_tilt),
+            });
+        }
+        count("minInliers", self.min_inliers, 3, 100_000_000)?;
+        count("maxHypotheses", self.max_hypotheses, 1, 1_000_000)?;
+        frac("confidence", self.confidence, true)?;
+        if self.confidence >= 1.0 {
+            return Err(Error::BadOption {
+                key: "confidence".into(),
+                reason: "must be below 1".into(),
+            });
+        }
+        pos("sampleRadius", self.sample_radius, 1000.0)?;
+        pos("clusterTolerance", self.cluster_tolerance, 1000.0)?;
+        pos("alpha", self.alpha, 1000.0)?;
+        pos("groundAlpha", self.ground_alpha, 1000.0)?;
+        pos("cell", self.cell, 100.0)?;
+        if self.cell < 0.01 {
+            return Err(Error::BadOption {
+                key: "cell".into(),
+                reason: format!("must be at least 0.01 m, got {}", self.cell),
+            });
+        }
+        if !(self.simplify.is_finite() && (0.0..=100.0).contains(&self.simplify)) {
+            return Err(Error::BadOption {
+                key: "simplify".into(),
+                reason: format!("must be in [0, 100] m, got {}", self.simplify),
+            });
+        }
+        count("maxVertices", self.max_vertices, 4, 100_000)?;
+        if !(self.min_area.is_finite() && self.min_area >= 0.0) {
+            return Err(Error::BadOption {
+                key: "minArea".into(),
+                reason: format!("must be a number >= 0, got {}", self.min_area),
+            });
+        }
+        if !(self.min_width.is_finite() && self.min_width >= 0.0) {
+            return Err(Error::BadOption {
+                key: "minWidth".into(),
+                reason: format!("must be a number >= 0, got {}", self.min_width),
+            });
+        }
+        if !(self.min_density.is_finite() && self.min_density >= 0.0) {
+            return Err(Error::BadOption {
+                key: "minDensity".into(),
+                reason: format!("must be a number >= 0, got {}", self.min_density),
+            });
+        }
+        frac("minOccupancy", self.min_occupancy, false)?;
+        count("maxPrimitives", self.max_primitives, 1, 100_000)?;
+        count("maxRejections", self.max_rejections, 1, 1_000_000)?;
+        if self.max_work == 0 {
+            return Err(Error::BadOption {
+                key: "maxWork".into(),
+                reason: "must be positive".into(),
+            });
+        }
+        pos("groundExpandAcross", self.ground_expand_across, 100.0)?;
+        pos("groundExpandAlong", self.ground_expand_along, 1000.0)?;
+        pos("expandAcross", self.expand_across, 100.0)?;
+        pos("expandAlong", self.expand_along, 1000.0)?;
+        pos("mergeAngle", self.merge_angle, 90.0)?;
+        pos("mergeDistance", self.merge_distance, 100.0)?;
+        if !(self.merge_gap.is_finite() && (0.0..=100.0).contains(&self.merge_gap)) {
+            return Err(Error::BadOption {
+                key: "mergeGap".into(),
+                reason: format!("must be in [0, 100] m, got {}", self.merge_gap),
+            });
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn presets_validate_and_errors_name_the_key() {
+        Params::gpp1().validate().unwrap();
+        Params::gpp2().validate().unwrap();
+        assert!(Params::preset("gpp3").is_err());
+        let bad = Params {
+            cluster_tolerance: f64::NAN,
+            ..Params::gpp2()
+        };
+        let e = bad.validate().unwrap_err().to_string();
+        assert!(e.contains("clusterTolerance"), "{e}");
+        let bad = Params {
+            min_occupancy: 1.5,
+            ..Params::gpp2()
+        };
+        assert!(bad
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("minOccupancy"));
+    }
+
+    #[test]
+    fn serde_rejects_unknown_keys_and_fills_defaults() {
+        let p: Params = serde_json::from_str(r#"{"minArea": 3.0, "hull": "convex"}"#).unwrap();
+        assert_eq!(p.min_area, 3.0);
+        assert_eq!(p.hull, HullKind::Convex);
+        assert_eq!(p.alpha, Params::gpp2().alpha);
+        let e = serde_json::from_str::<Params>(r#"{"minAreaa": 3.0}"#).unwrap_err();
+        assert!(e.to_string().contains("minAreaa"));
+    }
+}

@@ -1,0 +1,279 @@
+//! A geometric polygonal primitive: support plane, local frame, outline,
+//! running statistics and an occupancy footprint, plus the "shaping" step
+//! that turns a support set into one (PCA refit, outline, area, solidity).
+
+use crate::geometry::polygon::{signed_area, simplify};
+use crate::geometry::{convex_hull, Footprint, Frame, Moments, Plane, Polygon3};
+use crate::params::{HullKind, Params, SolidityKind};
+use glam::{DVec2, DVec3, Vec3};
+use serde::{Deserialize, Serialize};
+
+/// One planar polygon of the scenario.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Primitive {
+    /// Stable id (kept while the primitive grows or absorbs another).
+    pub id: u32,
+    /// Support plane (world frame); the normal points up for ground, else
+    /// towards the sensor that first saw it.
+    pub plane: Plane,
+    /// 2D frame on the plane the outline is expressed in.
+    pub frame: Frame,
+    /// Outline in frame coordinates (m), simple and counter-clockwise seen
+    /// from the normal side.
+    pub outline: Vec<DVec2>,
+    /// Outline area (m^2).
+    pub area: f64,
+    /// Number of points that support it (over all scans).
+    pub support: u64,
+    /// Near-horizontal (within `Params::ground_max_tilt`): road, sidewalk.
+    pub ground: bool,
+    /// Running moments of all support points (f64), for refits.
+    pub moments: Moments,
+    /// Where support points fell, in frame coordinates.
+    pub footprint: Footprint,
+    /// Scan in which it was detected.
+    pub born_scan: u64,
+    /// Last scan in which it gained support.
+    pub last_scan: u64,
+}
+
+impl Primitive {
+    /// Support points per square metre of outline.
+    pub fn density(&self) -> f64 {
+        if self.area > 0.0 {
+            self.support as f64 / self.area
+        } else {
+            0.0
+        }
+    }
+
+    /// Share of the outline's area whose footprint cells hold support (0..1).
+    pub fn occupancy(&self) -> f64 {
+        if self.area > 0.0 {
+            (self.footprint.occupied_area() / self.area).min(1.0)
+        } else {
+            0.0
+        }
+    }
+
+    /// Outline vertices in world coordinates, in order.
+    pub fn vertices(&self) -> Vec<DVec3> {
+        self.outline
+            .iter()
+            .map(|&q| self.frame.to_world(q))
+            .collect()
+    }
+
+    /// The outline as a 3D polygon.
+    pub fn polygon(&self) -> Polygon3 {
+        Polygon3 {
+            frame: self.frame,
+            ring: self.outline.clone(),
+        }
+    }
+
+    /// Does it pass the acceptance tests: at least `min_inliers` support
+    /// points, area above `min_area`, width above `min_width`, solidity?
+    pub fn acceptable(&self, params: &Params) -> bool {
+        self.support >= params.min_inliers as u64
+            && self.area >= params.min_area
+            && min_width(&self.outline) >= params.min_width
+            && match params.solidity {
+                SolidityKind::Density => self.density() >= params.min_density,
+                SolidityKind::Occupancy => self.occupancy() >= params.min_occupancy,
+            }
+    }
+
+    /// Outline radius used for this primitive (m).
+    pub fn alpha(&self, params: &Params) -> f64 {
+        if self.ground {
+            params.ground_alpha
+        } else {
+            params.alpha
+        }
+    }
+
+    /// Recompute the outline after the footprint or hull points changed.
+    /// `extra` are new support points (frame coordinates) for convex hulls.
+    /// Returns false (leaving the primitive unchanged) when no outline exists.
+    pub(crate) fn reshape(&mut self, params: &Params, extra: &[DVec2]) -> bool {
+        let ring = match params.hull {
+            HullKind::Convex => {
+                let mut pts = self.outline.clone();
+                pts.extend_from_slice(extra);
+                convex_hull(&pts).map(|h| cap_convex(h, params))
+            }
+            HullKind::Concave => {
+                self.footprint
+                    .outline(self.alpha(params), params.simplify, params.max_vertices)
+            }
+        };
+        match ring {
+            Some(r) if r.len() >= 3 => {
+                self.area = signed_area(&r);
+                self.outline = r;
+                true
+            }
+            _ => false,
+        }
+    }
+}
+
+/// Smallest width of the outline's convex hull (rotating calipers over the
+/// hull edges), in metres.
+pub fn min_width(ring: &[DVec2]) -> f64 {
+    let Some(h) = convex_hull(ring) else {
+        return 0.0;
+    };
+    let n = h.len();
+    let mut best = f64::INFINITY;
+    for i in 0..n {
+        let (a, b) = (h[i], h[(i + 1) % n]);
+        let e = (b - a).normalize_or_zero();
+        let w = h.iter().map(|&p| e.perp_dot(p - a)).fold(0.0f64, f64::max);
+        best = best.min(w);
+    }
+    best
+}
+
+fn cap_convex(h: Vec<DVec2>, params: &Params) -> Vec<DVec2> {
+    if h.len() > params.max_vertices {
+        simplify(&h, params.simplify, params.max_vertices)
+    } else {
+        h
+    }
+}
+
+/// The result of shaping a support set: the primitive (id 0, scans 0) and
+/// which of the given points it kept as support (a concave outline keeps
+/// only the largest connected region).
+pub(crate) struct Shaped {
+    pub primitive: Primitive,
+    pub kept: Vec<bool>,
+}
+
+/// PCA refit, frame, footprint, outline and area of a support set given in
+/// local coordinates relative to `origin`. `None` for degenerate sets (fewer
+/// than three points, collinear) or when no outline exists.
+pub(crate) fn shape(
+    origin: DVec3,
+    pts: &[Vec3],
+    params: &Params,
+    viewpoint: DVec3,
+) -> Option<Shaped> {
+    let first = origin + pts.first()?.as_dvec3();
+    let moments_of = |keep: &dyn Fn(usize) -> bool| {
+        let mut m = Moments::new(first.round());
+        for (i, p) in pts.iter().enumerate() {
+            if keep(i) {
+                m.push(origin + p.as_dvec3());
+            }
+        }
+        m
+    };
+    let mut moments = moments_of(&|_| true);
+    let tilt = params.ground_max_tilt.to_radians();
+    let (mut fit, _) = moments.fit_plane()?;
+    // Robust refit: points of a crossing surface within the inlier distance
+    // (the edge of a riser under a tread) tilt a plain least-squares plane.
+    // Refit on the points within three robust standard deviations
+    // (1.4826 x median absolute residual), twice. These points' moments are
+    // what the primitive keeps for later refits.
+    let mut resid: Vec<f64> = Vec::with_capacity(pts.len());
+    let mut inner = vec![true; pts.len()];
+    for _ in 0..2 {
+        resid.clear();
+        resid.extend(pts.iter().map(|p| fit.signed_distance(origin + p.as_dvec3()).abs()));
+        let mut sorted = resid.clone();
+        let mid = sorted.len() / 2;
+        let (_, med, _) = sorted.select_nth_unstable_by(mid, f64::total_cmp);
+        let cut = (3.0 * 1.4826 * *med).max(1e-4);
+        let trimmed = moments_of(&|i| resid[i] <= cut);
+        match trimmed.fit_plane() {
+            Some((f, _)) if trimmed.count >= 3.0 => {
+                fit = f;
+                moments = trimmed;
+                for (k, r) in inner.iter_mut().zip(&resid) {
+                    *k = *r <= cut;
+                }
+            }
+            _ => break,
+        }
+    }
+    let plane = fit.oriented(viewpoint, tilt);
+    let ground = plane.is_horizontal(tilt);
+    let frame = Frame::on_plane(&plane, moments.mean());
+    // Support is what lies within the inlier distance of the final plane.
+    let threshold = if ground {
+        params.ground_distance
+    } else {
+        params.distance
+    };
+    let near: Vec<bool> = pts
+        .iter()
+        .map(|p| plane.signed_distance(origin + p.as_dvec3()).abs() < threshold)
+        .collect();
+    let q: Vec<DVec2> = pts
+        .iter()
+        .map(|p| frame.to_local(origin + p.as_dvec3()))
+        .collect();
+    let alpha = if ground {
+        params.ground_alpha
+    } else {
+        params.alpha
+    };
+    let q_near: Vec<DVec2> = q
+        .iter()
+        .zip(&near)
+        .filter_map(|(&p, &k)| k.then_some(p))
+        .collect();
+    let mut footprint = Footprint::new(params.cell);
+    footprint.mark_all(&q_near);
+    let (outline, kept) = match params.hull {
+        HullKind::Convex => {
+            let h = cap_convex(convex_hull(&q_near)?, params);
+            (h, near)
+        }
+        HullKind::Concave => {
+            let (ring, region) =
+                footprint.outline_region(alpha, params.simplify, params.max_vertices)?;
+            let kept: Vec<bool> = q
+                .iter()
+                .zip(&near)
+                .map(|(&p, &k)| k && region.contains(p))
+                .collect();
+            (ring, kept)
+        }
+    };
+    let support = kept.iter().filter(|&&k| k).count() as u64;
+    if kept.iter().any(|k| !k) {
+        moments = moments_of(&|i| kept[i] && inner[i]);
+        footprint = Footprint::new(params.cell);
+        let q_kept: Vec<DVec2> = q
+            .iter()
+            .zip(&kept)
+            .filter_map(|(&p, &k)| k.then_some(p))
+            .collect();
+        footprint.mark_all(&q_kept);
+    }
+    let area = signed_area(&outline);
+    if !(area > 0.0) {
+        return None;
+    }
+    Some(Shaped {
+        primitive: Primitive {
+            id: 0,
+            plane,
+            frame,
+            outline,
+            area,
+            support,
+            ground,
+            moments,
+            footprint,
+            born_scan: 0,
+            last_scan: 0,
+        },
+        kept,
+    })
+}

@@ -1,0 +1,411 @@
+//! One-shot detection (Algorithm 1) on scenes with known answers.
+
+mod common;
+
+use common::*;
+use glam::{DVec2, DVec3};
+use polyscene::cloud::Cloud;
+use polyscene::detect::detect;
+use polyscene::geometry::polygon::contains;
+use polyscene::geometry::{Frame, Plane};
+use polyscene::params::{HullKind, Params};
+use polyscene::rng::Rng;
+use polyscene::Error;
+
+fn box_room(rng: &mut Rng) -> Vec<DVec3> {
+    // 10 x 8 x 3 m room, sampled every 5 cm with 1 cm noise.
+    let mut pts = Vec::new();
+    let (x, y, z) = (DVec3::X, DVec3::Y, DVec3::Z);
+    let s = 0.05;
+    rect(&mut pts, DVec3::ZERO, x, y, 10.0, 8.0, s, 0.01, rng); // floor
+    rect(
+        &mut pts,
+        DVec3::new(0.0, 0.0, 3.0),
+        x,
+        y,
+        10.0,
+        8.0,
+        s,
+        0.01,
+        rng,
+    ); // ceiling
+    rect(&mut pts, DVec3::ZERO, x, z, 10.0, 3.0, s, 0.01, rng); // y = 0
+    rect(
+        &mut pts,
+        DVec3::new(0.0, 8.0, 0.0),
+        x,
+        z,
+        10.0,
+        3.0,
+        s,
+        0.01,
+        rng,
+    ); // y = 8
+    rect(&mut pts, DVec3::ZERO, y, z, 8.0, 3.0, s, 0.01, rng); // x = 0
+    rect(
+        &mut pts,
+        DVec3::new(10.0, 0.0, 0.0),
+        y,
+        z,
+        8.0,
+        3.0,
+        s,
+        0.01,
+        rng,
+    ); // x = 10
+    pts
+}
+
+#[test]
+fn box_room_gives_six_faces() {
+    let mut rng = Rng::new(1);
+    let pts = box_room(&mut rng);
+    let cloud = cloud(&pts);
+    for hull in [HullKind::Convex, HullKind::Concave] {
+        let p = Params {
+            hull,
+            ..Params::gpp2()
+        };
+        let det = detect(&cloud, &p).unwrap();
+        check_invariants(&cloud, &det, &p);
+        assert_eq!(det.primitives.len(), 6, "{hull:?}");
+        let centre = DVec3::new(5.0, 4.0, 1.5);
+        let mut areas: Vec<f64> = det.primitives.iter().map(|q| q.area).collect();
+        areas.sort_by(f64::total_cmp);
+        let expect = [24.0, 24.0, 30.0, 30.0, 80.0, 80.0];
+        // Faces found later lose the strips within the inlier distance of the
+        // faces found before them (each point belongs to one primitive); a
+        // concave outline is exact to half a raster cell (perimeter x 0.1 m).
+        for (a, e) in areas.iter().zip(expect) {
+            assert!(*a > 0.8 * e && *a < 1.06 * e, "{hull:?}: area {a} vs {e}");
+        }
+        for q in &det.primitives {
+            let n = q.plane.normal;
+            let axis = n.abs().max_element();
+            assert!(axis > 0.999, "normal {n} not axis aligned");
+            if !q.ground {
+                // Walls face the room's centre (the viewpoint is the centroid).
+                assert!(q.plane.signed_distance(centre) > 0.0);
+            }
+        }
+        // Most points are explained.
+        let explained = det.labels.iter().filter(|&&l| l != u32::MAX).count();
+        assert!(explained as f64 > 0.95 * pts.len() as f64);
+    }
+}
+
+#[test]
+fn staircase_gives_each_tread_and_riser() {
+    // Five steps, 1.2 m deep, 0.5 m high, 4 m wide.
+    let mut rng = Rng::new(2);
+    let mut pts = Vec::new();
+    for k in 0..5 {
+        let x0 = k as f64 * 1.2;
+        let z0 = k as f64 * 0.5;
+        rect(
+            &mut pts,
+            DVec3::new(x0, 0.0, z0),
+            DVec3::X,
+            DVec3::Y,
+            1.2,
+            4.0,
+            0.04,
+            0.005,
+            &mut rng,
+        );
+        rect(
+            &mut pts,
+            DVec3::new(x0 + 1.2, 0.0, z0),
+            DVec3::Y,
+            DVec3::Z,
+            4.0,
+            0.5,
+            0.04,
+            0.005,
+            &mut rng,
+        );
+    }
+    let cloud = cloud(&pts);
+    let p = Params {
+        min_area: 1.0,
+        distance: 0.05,
+        ground_distance: 0.05,
+        ..Params::gpp2()
+    };
+    let det = detect(&cloud, &p).unwrap();
+    check_invariants(&cloud, &det, &p);
+    let treads: Vec<f64> = det
+        .primitives
+        .iter()
+        .filter(|q| q.ground)
+        .map(|q| -q.plane.offset)
+        .collect();
+    let risers = det.primitives.iter().filter(|q| !q.ground).count();
+    assert_eq!(treads.len(), 5, "treads at {treads:?}");
+    assert_eq!(risers, 5);
+    for k in 0..5 {
+        let z = k as f64 * 0.5;
+        assert!(
+            treads.iter().any(|t| (t - z).abs() < 0.02),
+            "no tread at {z}: {treads:?}"
+        );
+    }
+}
+
+#[test]
+fn coplanar_walls_with_a_gap_stay_two_polygons() {
+    let mut rng = Rng::new(3);
+    let mut pts = Vec::new();
+    rect(
+        &mut pts,
+        DVec3::ZERO,
+        DVec3::X,
+        DVec3::Z,
+        6.0,
+        3.0,
+        0.05,
+        0.01,
+        &mut rng,
+    );
+    rect(
+        &mut pts,
+        DVec3::new(9.0, 0.0, 0.0),
+        DVec3::X,
+        DVec3::Z,
+        6.0,
+        3.0,
+        0.05,
+        0.01,
+        &mut rng,
+    );
+    let cloud = cloud(&pts);
+    for hull in [HullKind::Convex, HullKind::Concave] {
+        let p = Params {
+            hull,
+            ..Params::gpp2()
+        };
+        let det = detect(&cloud, &p).unwrap();
+        check_invariants(&cloud, &det, &p);
+        assert_eq!(det.primitives.len(), 2, "{hull:?}");
+        for q in &det.primitives {
+            assert!((q.area - 18.0).abs() < 1.0, "area {}", q.area);
+            // Nothing of the gap is covered.
+            let gap = q.frame.to_local(DVec3::new(7.5, 0.0, 1.5));
+            assert!(!contains(&q.outline, gap));
+        }
+    }
+}
+
+#[test]
+fn concave_outline_leaves_the_missing_corner_of_an_l_wall_uncovered() {
+    let mut rng = Rng::new(4);
+    let f = Frame::on_plane(
+        &Plane::from_point_normal(DVec3::ZERO, -DVec3::Y),
+        DVec3::ZERO,
+    );
+    let mut pts = Vec::new();
+    // L: 10 x 6 minus the upper-right 5 x 3 block.
+    region(
+        &mut pts,
+        &f,
+        DVec2::ZERO,
+        DVec2::new(10.0, 6.0),
+        0.05,
+        0.01,
+        &mut rng,
+        |q| !(q.x.abs() > 5.0 && q.y > 3.0),
+    );
+    let cloud = cloud(&pts);
+    let p = Params::gpp2();
+    let det = detect(&cloud, &p).unwrap();
+    check_invariants(&cloud, &det, &p);
+    assert_eq!(det.primitives.len(), 1);
+    let q = &det.primitives[0];
+    let world_corner = f.to_world(DVec2::new(6.5, 4.0));
+    let world_arm = f.to_world(DVec2::new(2.5, 4.5));
+    assert!(
+        !contains(&q.outline, q.frame.to_local(world_corner)),
+        "corner covered"
+    );
+    assert!(contains(&q.outline, q.frame.to_local(world_arm)));
+    assert!((q.area - 45.0).abs() < 2.0, "area {}", q.area);
+    // The convex hull, by contrast, covers the corner.
+    let p = Params {
+        hull: HullKind::Convex,
+        ..Params::gpp2()
+    };
+    let det = detect(&cloud, &p).unwrap();
+    let q = &det.primitives[0];
+    assert!(contains(&q.outline, q.frame.to_local(world_corner)));
+}
+
+#[test]
+fn planes_survive_heavy_outliers() {
+    let mut rng = Rng::new(5);
+    let mut pts = Vec::new();
+    rect(
+        &mut pts,
+        DVec3::ZERO,
+        DVec3::X,
+        DVec3::Y,
+        20.0,
+        20.0,
+        0.1,
+        0.02,
+        &mut rng,
+    );
+    let n = DVec3::new(1.0, 1.0, 0.0).normalize();
+    let u = DVec3::Z.cross(n);
+    rect(
+        &mut pts,
+        DVec3::new(10.0, 10.0, 0.0) - u * 5.0,
+        u,
+        DVec3::Z,
+        10.0,
+        4.0,
+        0.1,
+        0.02,
+        &mut rng,
+    );
+    rect(
+        &mut pts,
+        DVec3::new(0.0, 20.0, 0.0),
+        DVec3::X,
+        DVec3::Z,
+        20.0,
+        5.0,
+        0.1,
+        0.02,
+        &mut rng,
+    );
+    let planar = pts.len();
+    // As many outliers as plane points, uniform in the scene's box.
+    for _ in 0..planar {
+        pts.push(DVec3::new(
+            rng.range(0.0, 20.0),
+            rng.range(0.0, 20.0),
+            rng.range(0.0, 5.0),
+        ));
+    }
+    let cloud = cloud(&pts);
+    let p = Params::gpp2();
+    let det = detect(&cloud, &p).unwrap();
+    check_invariants(&cloud, &det, &p);
+    let truth = [DVec3::Z, n, DVec3::Y];
+    for t in truth {
+        let best = det
+            .primitives
+            .iter()
+            .filter(|q| q.area > 10.0)
+            .map(|q| q.plane.normal.dot(t).abs())
+            .fold(0.0, f64::max);
+        assert!(best > libm::cos(2f64.to_radians()), "plane {t} not found");
+    }
+    // Random outliers do not make big polygons of their own.
+    let big = det.primitives.iter().filter(|q| q.area > 10.0).count();
+    assert_eq!(
+        big,
+        3,
+        "{:?}",
+        det.primitives.iter().map(|q| q.area).collect::<Vec<_>>()
+    );
+}
+
+#[test]
+fn degenerate_inputs_give_empty_or_trivial_answers() {
+    let p = Params::gpp2();
+    let empty = Cloud::from_flat(&[], 3).unwrap();
+    assert!(detect(&empty, &p).unwrap().primitives.is_empty());
+    for n in 1..=3 {
+        let pts: Vec<f32> = (0..n)
+            .flat_map(|i| [i as f32, (i * i) as f32, 0.0])
+            .collect();
+        let c = Cloud::from_flat(&pts, 3).unwrap();
+        assert!(detect(&c, &p).unwrap().primitives.is_empty());
+    }
+    let line: Vec<DVec3> = (0..5000)
+        .map(|i| DVec3::new(i as f64 * 0.01, 2.0 * i as f64 * 0.01, 1.0))
+        .collect();
+    assert!(detect(&cloud(&line), &p).unwrap().primitives.is_empty());
+    let same = vec![DVec3::new(1.0, 2.0, 3.0); 5000];
+    assert!(detect(&cloud(&same), &p).unwrap().primitives.is_empty());
+    // All on one plane: one polygon.
+    let mut rng = Rng::new(6);
+    let mut pts = Vec::new();
+    rect(
+        &mut pts,
+        DVec3::ZERO,
+        DVec3::X,
+        DVec3::Y,
+        5.0,
+        5.0,
+        0.05,
+        0.0,
+        &mut rng,
+    );
+    let c = cloud(&pts);
+    let det = detect(&c, &p).unwrap();
+    check_invariants(&c, &det, &p);
+    assert_eq!(det.primitives.len(), 1);
+    assert_eq!(det.primitives[0].support as usize, pts.len());
+}
+
+#[test]
+fn bad_values_are_errors_not_panics() {
+    let e = Cloud::from_flat(&[0.0, 1.0, f32::NAN], 3).unwrap_err();
+    assert!(matches!(e, Error::NonFinite { point: 0 }));
+    let e = Cloud::from_flat(&[0.0, 1.0, 2.0, 3.0, f32::INFINITY, 0.0], 3).unwrap_err();
+    assert!(matches!(e, Error::NonFinite { point: 1 }));
+    assert!(matches!(
+        Cloud::from_flat(&[0.0; 7], 3),
+        Err(Error::BadLength { .. })
+    ));
+    assert!(matches!(
+        Cloud::from_flat(&[0.0; 6], 2),
+        Err(Error::BadStride(2))
+    ));
+    let bad = Params {
+        distance: -1.0,
+        ..Params::gpp2()
+    };
+    let e = detect(&Cloud::default(), &bad).unwrap_err();
+    assert!(e.to_string().contains("distance"));
+}
+
+#[test]
+fn same_input_and_seed_same_output() {
+    let mut rng = Rng::new(8);
+    let pts = box_room(&mut rng);
+    let c = cloud(&pts);
+    let p = Params::gpp2();
+    let a = detect(&c, &p).unwrap();
+    let b = detect(&c, &p).unwrap();
+    assert_eq!(a.primitives, b.primitives);
+    assert_eq!(a.labels, b.labels);
+}
+
+#[test]
+fn far_from_the_origin_gives_the_same_polygons_translated() {
+    let mut rng = Rng::new(9);
+    let pts = box_room(&mut rng);
+    let shift = DVec3::new(500_000.0, 4_500_000.0, 50.0);
+    let moved: Vec<DVec3> = pts.iter().map(|&p| p + shift).collect();
+    for hull in [HullKind::Convex, HullKind::Concave] {
+        let p = Params {
+            hull,
+            ..Params::gpp2()
+        };
+        let a = detect(&cloud(&pts), &p).unwrap();
+        let b = detect(&cloud(&moved), &p).unwrap();
+        assert_eq!(a.primitives.len(), b.primitives.len());
+        for (x, y) in a.primitives.iter().zip(&b.primitives) {
+            let (vx, vy) = (x.vertices(), y.vertices());
+            assert_eq!(vx.len(), vy.len());
+            for (u, v) in vx.iter().zip(&vy) {
+                assert!((*u + shift - *v).length() < 1e-3, "{hull:?}: {u} vs {v}");
+            }
+            assert!((x.plane.normal - y.plane.normal).length() < 1e-6);
+        }
+    }
+}
+
