@@ -19,5 +19,7 @@ pub mod io;
 pub mod params;
 pub mod primitive;
 pub mod rng;
+pub mod scenario;
+pub mod sim;
 
 pub use error::{Error, Result};

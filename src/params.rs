@@ -48,12 +48,21 @@ pub struct Params {
     /// Inlier distance to a plane for non-ground planes (m). Default 0.10
     /// (authors: 0.2, for noisier data; 0.2 swallows curbs and door recesses).
     pub distance: f64,
-    /// Inlier distance for near-horizontal (ground) planes (m). Default 0.12
+    /// Inlier distance for near-horizontal (ground) planes (m). Default 0.10
     /// (authors: 0.3; that merges the road with 0.15 m high sidewalks).
     pub ground_distance: f64,
     /// Largest tilt from horizontal for a plane to count as ground (deg).
     /// Default 15.
     pub ground_max_tilt: f64,
+    /// Ground lies at least this far below the sensor (m); a horizontal
+    /// plane higher up (a car roof, a table) is an ordinary primitive.
+    /// Default 1.0.
+    pub ground_depth: f64,
+    /// Sensor position for one-shot detection (world, m): normals of
+    /// non-horizontal planes point towards it, and it decides what is
+    /// ground. Default `[0, 0, 0]`: a scan in its own sensor frame. The
+    /// scenario uses each scan's pose instead.
+    pub viewpoint: [f64; 3],
     /// Fewest inliers a plane needs, and fewest support points a primitive
     /// needs; the cascade stops when the best plane has fewer. gpp2 default
     /// 150, gpp1 400.
@@ -86,6 +95,10 @@ pub struct Params {
     /// Raster cell size of footprints (m): the resolution of concave
     /// outlines and of the occupancy test. Default 0.2.
     pub cell: f64,
+    /// Raster cell size of ground footprints (m): the ground is large and
+    /// seen at grazing angles, a coarser cell keeps its outline cheap.
+    /// Default 0.4.
+    pub ground_cell: f64,
     /// Outline simplification tolerance (m). Default 0.1.
     pub simplify: f64,
     /// Most vertices of an outline (the tolerance is raised to meet it).
@@ -100,6 +113,11 @@ pub struct Params {
     /// rejects the thin strips a plane cuts out of a crossing surface.
     /// Default 0.4.
     pub min_width: f64,
+    /// Largest RMS distance of the support from its plane, as a fraction of
+    /// the inlier distance. A real surface sits within the sensor noise;
+    /// points spread evenly through the inlier slab (a plane slicing through
+    /// objects) give about 0.58. Default 0.45.
+    pub max_roughness: f64,
     /// Which solidity test to apply. Default occupancy.
     pub solidity: SolidityKind,
     /// Least support points per m^2 with `solidity: density`. Default 48
@@ -123,14 +141,18 @@ pub struct Params {
     /// Grow existing primitives with each scan before detecting new ones.
     /// Default true; false gives the paper's "without expansion" mode.
     pub expansion: bool,
-    /// Perpendicular gate of expansion, ground (m). Default 0.15 (authors 0.3).
+    /// Perpendicular gate of expansion, ground (m): at most this, and at
+    /// most three times the primitive's own RMS residual (never below
+    /// 0.03 m), so a primitive takes what continues it, not the edges of
+    /// surfaces crossing it. Default 0.08 (authors 0.3, which swallows
+    /// 0.15 m curbs).
     pub ground_expand_across: f64,
     /// Longitudinal growth reach per step, ground (m). Default 2.0 (authors
     /// 15, with a convex hull; with connectivity-based growth a smaller
     /// reach avoids jumping onto unrelated surfaces at the same height).
     pub ground_expand_along: f64,
-    /// Perpendicular gate of expansion, other primitives (m). Default 0.12
-    /// (authors 0.5).
+    /// Perpendicular gate of expansion, other primitives (m), adapted to the
+    /// primitive's residual like the ground's. Default 0.08 (authors 0.5).
     pub expand_across: f64,
     /// Longitudinal growth reach per step, other primitives (m). Default 0.6
     /// (authors 0.2).
@@ -155,8 +177,10 @@ impl Params {
     pub fn gpp2() -> Self {
         Params {
             distance: 0.10,
-            ground_distance: 0.12,
+            ground_distance: 0.10,
             ground_max_tilt: 15.0,
+            ground_depth: 1.0,
+            viewpoint: [0.0; 3],
             min_inliers: 150,
             max_hypotheses: 400,
             confidence: 0.995,
@@ -167,10 +191,12 @@ impl Params {
             alpha: 0.5,
             ground_alpha: 1.5,
             cell: 0.2,
+            ground_cell: 0.4,
             simplify: 0.1,
             max_vertices: 64,
             min_area: 1.5,
             min_width: 0.4,
+            max_roughness: 0.45,
             solidity: SolidityKind::Occupancy,
             min_density: 48.0,
             min_occupancy: 0.3,
@@ -178,9 +204,9 @@ impl Params {
             max_rejections: 24,
             max_work: 2_000_000_000,
             expansion: true,
-            ground_expand_across: 0.15,
+            ground_expand_across: 0.08,
             ground_expand_along: 2.0,
-            expand_across: 0.12,
+            expand_across: 0.08,
             expand_along: 0.6,
             merge_angle: 8.0,
             merge_distance: 0.12,
@@ -249,6 +275,19 @@ impl Params {
                 reason: format!("must be in [0, 90] degrees, got {}", self.ground_max_tilt),
             });
         }
+        if !(self.ground_depth.is_finite() && self.ground_depth >= 0.0) {
+            return Err(Error::BadOption {
+                key: "groundDepth".into(),
+                reason: format!("must be a number >= 0, got {}", self.ground_depth),
+            });
+        }
+        if self.viewpoint.iter().any(|v| !v.is_finite()) {
+            return Err(Error::BadOption {
+                key: "viewpoint".into(),
+                reason: "must be three finite numbers".into(),
+            });
+        }
+        pos("maxRoughness", self.max_roughness, 10.0)?;
         count("minInliers", self.min_inliers, 3, 100_000_000)?;
         count("maxHypotheses", self.max_hypotheses, 1, 1_000_000)?;
         frac("confidence", self.confidence, true)?;
@@ -267,6 +306,13 @@ impl Params {
             return Err(Error::BadOption {
                 key: "cell".into(),
                 reason: format!("must be at least 0.01 m, got {}", self.cell),
+            });
+        }
+        pos("groundCell", self.ground_cell, 100.0)?;
+        if self.ground_cell < 0.01 {
+            return Err(Error::BadOption {
+                key: "groundCell".into(),
+                reason: format!("must be at least 0.01 m, got {}", self.ground_cell),
             });
         }
         if !(self.simplify.is_finite() && (0.0..=100.0).contains(&self.simplify)) {

@@ -13,8 +13,8 @@ use serde::{Deserialize, Serialize};
 pub struct Primitive {
     /// Stable id (kept while the primitive grows or absorbs another).
     pub id: u32,
-    /// Support plane (world frame); the normal points up for ground, else
-    /// towards the sensor that first saw it.
+    /// Support plane (world frame); the normal points towards the sensor
+    /// that first saw it.
     pub plane: Plane,
     /// 2D frame on the plane the outline is expressed in.
     pub frame: Frame,
@@ -72,12 +72,26 @@ impl Primitive {
         }
     }
 
+    /// RMS distance of the (robust inner) support from the plane (m).
+    pub fn rms(&self) -> f64 {
+        self.moments
+            .fit_plane()
+            .map_or(0.0, |(_, vals)| vals[0].max(0.0).sqrt())
+    }
+
     /// Does it pass the acceptance tests: at least `min_inliers` support
-    /// points, area above `min_area`, width above `min_width`, solidity?
+    /// points, area above `min_area`, width above `min_width`, roughness
+    /// below `max_roughness`, solidity?
     pub fn acceptable(&self, params: &Params) -> bool {
+        let distance = if self.ground {
+            params.ground_distance
+        } else {
+            params.distance
+        };
         self.support >= params.min_inliers as u64
             && self.area >= params.min_area
             && min_width(&self.outline) >= params.min_width
+            && self.rms() <= params.max_roughness * distance
             && match params.solidity {
                 SolidityKind::Density => self.density() >= params.min_density,
                 SolidityKind::Occupancy => self.occupancy() >= params.min_occupancy,
@@ -183,7 +197,10 @@ pub(crate) fn shape(
     let mut inner = vec![true; pts.len()];
     for _ in 0..2 {
         resid.clear();
-        resid.extend(pts.iter().map(|p| fit.signed_distance(origin + p.as_dvec3()).abs()));
+        resid.extend(
+            pts.iter()
+                .map(|p| fit.signed_distance(origin + p.as_dvec3()).abs()),
+        );
         let mut sorted = resid.clone();
         let mid = sorted.len() / 2;
         let (_, med, _) = sorted.select_nth_unstable_by(mid, f64::total_cmp);
@@ -200,8 +217,11 @@ pub(crate) fn shape(
             _ => break,
         }
     }
-    let plane = fit.oriented(viewpoint, tilt);
-    let ground = plane.is_horizontal(tilt);
+    let plane = fit.oriented(viewpoint);
+    // Ground: near-horizontal, facing up, well below the sensor.
+    let ground = plane.is_horizontal(tilt)
+        && plane.normal.z > 0.0
+        && plane.signed_distance(viewpoint) > params.ground_depth;
     let frame = Frame::on_plane(&plane, moments.mean());
     // Support is what lies within the inlier distance of the final plane.
     let threshold = if ground {
@@ -227,7 +247,8 @@ pub(crate) fn shape(
         .zip(&near)
         .filter_map(|(&p, &k)| k.then_some(p))
         .collect();
-    let mut footprint = Footprint::new(params.cell);
+    let cell = if ground { params.ground_cell } else { params.cell };
+    let mut footprint = Footprint::new(cell);
     footprint.mark_all(&q_near);
     let (outline, kept) = match params.hull {
         HullKind::Convex => {
@@ -248,7 +269,7 @@ pub(crate) fn shape(
     let support = kept.iter().filter(|&&k| k).count() as u64;
     if kept.iter().any(|k| !k) {
         moments = moments_of(&|i| kept[i] && inner[i]);
-        footprint = Footprint::new(params.cell);
+        footprint = Footprint::new(cell);
         let q_kept: Vec<DVec2> = q
             .iter()
             .zip(&kept)

@@ -64,6 +64,7 @@ fn box_room_gives_six_faces() {
     for hull in [HullKind::Convex, HullKind::Concave] {
         let p = Params {
             hull,
+            viewpoint: [5.0, 4.0, 1.8],
             ..Params::gpp2()
         };
         let det = detect(&cloud, &p).unwrap();
@@ -83,11 +84,13 @@ fn box_room_gives_six_faces() {
             let n = q.plane.normal;
             let axis = n.abs().max_element();
             assert!(axis > 0.999, "normal {n} not axis aligned");
-            if !q.ground {
-                // Walls face the room's centre (the viewpoint is the centroid).
-                assert!(q.plane.signed_distance(centre) > 0.0);
-            }
+            // Every face's normal points into the room, towards the sensor.
+            assert!(q.plane.signed_distance(centre) > 0.0);
         }
+        // Only the floor is ground: the ceiling is above the sensor.
+        let ground: Vec<f64> = det.primitives.iter().filter(|q| q.ground).map(|q| q.plane.offset).collect();
+        assert_eq!(ground.len(), 1);
+        assert!(ground[0].abs() < 0.02);
         // Most points are explained.
         let explained = det.labels.iter().filter(|&&l| l != u32::MAX).count();
         assert!(explained as f64 > 0.95 * pts.len() as f64);
@@ -126,10 +129,15 @@ fn staircase_gives_each_tread_and_riser() {
         );
     }
     let cloud = cloud(&pts);
+    // A small-scale scene: finer raster and width limits than the street
+    // defaults (risers are 0.4 m tall once the treads took their edges).
     let p = Params {
         min_area: 1.0,
+        min_width: 0.2,
+        cell: 0.08,
         distance: 0.05,
         ground_distance: 0.05,
+        viewpoint: [3.0, 2.0, 5.0],
         ..Params::gpp2()
     };
     let det = detect(&cloud, &p).unwrap();
@@ -216,7 +224,10 @@ fn concave_outline_leaves_the_missing_corner_of_an_l_wall_uncovered() {
         |q| !(q.x.abs() > 5.0 && q.y > 3.0),
     );
     let cloud = cloud(&pts);
-    let p = Params::gpp2();
+    let p = Params {
+        viewpoint: [5.0, -6.0, 1.8],
+        ..Params::gpp2()
+    };
     let det = detect(&cloud, &p).unwrap();
     check_invariants(&cloud, &det, &p);
     assert_eq!(det.primitives.len(), 1);
@@ -232,6 +243,7 @@ fn concave_outline_leaves_the_missing_corner_of_an_l_wall_uncovered() {
     // The convex hull, by contrast, covers the corner.
     let p = Params {
         hull: HullKind::Convex,
+        viewpoint: [5.0, -6.0, 1.8],
         ..Params::gpp2()
     };
     let det = detect(&cloud, &p).unwrap();
@@ -288,7 +300,10 @@ fn planes_survive_heavy_outliers() {
         ));
     }
     let cloud = cloud(&pts);
-    let p = Params::gpp2();
+    let p = Params {
+        viewpoint: [10.0, 5.0, 1.8],
+        ..Params::gpp2()
+    };
     let det = detect(&cloud, &p).unwrap();
     check_invariants(&cloud, &det, &p);
     let truth = [DVec3::Z, n, DVec3::Y];
@@ -393,10 +408,15 @@ fn far_from_the_origin_gives_the_same_polygons_translated() {
     for hull in [HullKind::Convex, HullKind::Concave] {
         let p = Params {
             hull,
+            viewpoint: [5.0, 4.0, 1.8],
             ..Params::gpp2()
         };
+        let far = Params {
+            viewpoint: (DVec3::new(5.0, 4.0, 1.8) + shift).to_array(),
+            ..p.clone()
+        };
         let a = detect(&cloud(&pts), &p).unwrap();
-        let b = detect(&cloud(&moved), &p).unwrap();
+        let b = detect(&cloud(&moved), &far).unwrap();
         assert_eq!(a.primitives.len(), b.primitives.len());
         for (x, y) in a.primitives.iter().zip(&b.primitives) {
             let (vx, vy) = (x.vertices(), y.vertices());
@@ -408,4 +428,3 @@ fn far_from_the_origin_gives_the_same_polygons_translated() {
         }
     }
 }
-

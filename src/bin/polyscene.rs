@@ -7,8 +7,10 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     match cli::run(&args) {
         Ok(out) => {
+            use std::io::Write;
             if !out.is_empty() {
-                println!("{out}");
+                // A closed pipe (`| head`) is not an error worth a panic.
+                let _ = writeln!(std::io::stdout(), "{out}");
             }
         }
         Err(e) => {

@@ -47,8 +47,8 @@ pub fn clusters(points: &[DVec2], tol: f64) -> (Vec<u32>, Vec<u32>) {
     let mut cell_of = Vec::with_capacity(n);
     for p in points {
         let (cx, cy) = (
-            libm::floor(p.x / side) as i64,
-            libm::floor(p.y / side) as i64,
+            crate::hash::floor_i64(p.x / side),
+            crate::hash::floor_i64(p.y / side),
         );
         let id = *map.entry(key2(cx, cy)).or_insert_with(|| {
             cell_key.push((cx, cy));

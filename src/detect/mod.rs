@@ -53,9 +53,10 @@ pub struct Detection {
     pub time_ms: f64,
 }
 
-/// Detect planar polygons in a world-frame cloud. Normals of non-horizontal
-/// planes point towards the cloud's centroid (the sensor side, for street
-/// scans); use [`Detector::run`] to give another viewpoint.
+/// Detect planar polygons in a world-frame cloud seen from
+/// `params.viewpoint` (the sensor position; the origin for a scan in its own
+/// frame). Normals of non-horizontal planes point towards the viewpoint,
+/// near-horizontal ones up.
 ///
 /// ```
 /// use polyscene::{cloud::Cloud, detect::detect, params::Params};
@@ -67,17 +68,15 @@ pub struct Detection {
 ///     }
 /// }
 /// let cloud = Cloud::from_flat(&pts, 3).unwrap();
-/// let found = detect(&cloud, &Params::gpp2()).unwrap();
+/// // The sensor 1.8 m above the floor's centre.
+/// let params = Params { viewpoint: [5.0, 5.0, 1.8], ..Params::gpp2() };
+/// let found = detect(&cloud, &params).unwrap();
 /// assert_eq!(found.primitives.len(), 1);
 /// assert!((found.primitives[0].area - 99.0).abs() < 3.0);
 /// ```
 pub fn detect(cloud: &Cloud, params: &Params) -> Result<Detection> {
     params.validate()?;
-    let mut c = DVec3::ZERO;
-    for p in &cloud.points {
-        c += p.as_dvec3();
-    }
-    let viewpoint = cloud.origin + c / cloud.len().max(1) as f64;
+    let viewpoint = DVec3::from_array(params.viewpoint);
     Ok(Detector::new(params).run(&cloud.points, cloud.origin, viewpoint))
 }
 
@@ -95,9 +94,21 @@ impl<'p> Detector<'p> {
     /// Run the cascade on `pts` (local coordinates relative to `origin`).
     /// `viewpoint` (world) decides which way non-horizontal normals point.
     pub fn run(&self, pts: &[Vec3], origin: DVec3, viewpoint: DVec3) -> Detection {
+        self.run_with_rng(pts, origin, viewpoint, Rng::new(self.params.seed))
+    }
+
+    /// [`Detector::run`] with an explicit random generator (the scenario
+    /// derives one per scan from the seed).
+    pub fn run_with_rng(
+        &self,
+        pts: &[Vec3],
+        origin: DVec3,
+        viewpoint: DVec3,
+        rng: Rng,
+    ) -> Detection {
         let p = self.params;
         let t0 = clock::now_ms();
-        let mut pool = PlanePool::new(pts, p.sample_radius, Rng::new(p.seed));
+        let mut pool = PlanePool::new(pts, p.sample_radius, rng);
         let mut labels = vec![NO_PRIMITIVE; pts.len()];
         let mut primitives: Vec<Primitive> = Vec::new();
         let mut steps = Vec::new();
@@ -113,7 +124,7 @@ impl<'p> Detector<'p> {
             let ts = clock::now_ms();
             let points_left = pool.remaining();
             // 1. RANSAC: the plane with the largest consensus, or stop.
-            let Some((plane, inliers)) = pool.best_plane(p) else {
+            let Some((plane, inliers)) = pool.best_plane(p, viewpoint - origin) else {
                 break;
             };
             // 2. Cluster the inliers in the plane; the largest cluster is the support.

@@ -86,9 +86,9 @@ impl<'a> PlanePool<'a> {
         let mut cell_of = Vec::with_capacity(n);
         for p in pts {
             let k = key3(
-                libm::floor(p.x as f64 * inv) as i64,
-                libm::floor(p.y as f64 * inv) as i64,
-                libm::floor(p.z as f64 * inv) as i64,
+                crate::hash::floor_i64(p.x as f64 * inv),
+                crate::hash::floor_i64(p.y as f64 * inv),
+                crate::hash::floor_i64(p.z as f64 * inv),
             );
             let next = map.len() as u32;
             cell_of.push(*map.entry(k).or_insert(next));
@@ -157,14 +157,17 @@ impl<'a> PlanePool<'a> {
     /// The plane with the largest consensus among the remaining points and
     /// its inliers (original indices), or `None` when no plane has
     /// `min_inliers`.
-    pub fn best_plane(&mut self, params: &Params) -> Option<(LocalPlane, Vec<u32>)> {
+    /// `viewpoint` is the sensor in local coordinates: horizontal planes at
+    /// least `ground_depth` below it are counted with the ground distance.
+    pub fn best_plane(&mut self, params: &Params, viewpoint: DVec3) -> Option<(LocalPlane, Vec<u32>)> {
         let n = self.remaining();
         if n < params.min_inliers.max(3) {
             return None;
         }
         let tilt_cos = libm::cos(params.ground_max_tilt.to_radians());
-        let threshold_for = |nz: f64| {
-            if nz.abs() >= tilt_cos {
+        let threshold_for = |normal: DVec3, offset: f64| {
+            let depth = (normal.dot(viewpoint) + offset) * normal.z.signum();
+            if normal.z.abs() >= tilt_cos && depth > params.ground_depth {
                 params.ground_distance
             } else {
                 params.distance
@@ -183,7 +186,7 @@ impl<'a> PlanePool<'a> {
                 let plane = LocalPlane {
                     normal,
                     offset,
-                    threshold: threshold_for(normal.z),
+                    threshold: threshold_for(normal, offset),
                 };
                 // Cheap local test: the plane must explain a fair share of
                 // its own voxel, or the sample mixed surfaces / hit clutter.
@@ -211,7 +214,7 @@ impl<'a> PlanePool<'a> {
         if inliers.len() >= 3 {
             if let Some(refit) = self.refit(&inliers) {
                 let refit = LocalPlane {
-                    threshold: threshold_for(refit.normal.z),
+                    threshold: threshold_for(refit.normal, refit.offset),
                     ..refit
                 };
                 let again = self.collect(&refit);

@@ -60,8 +60,8 @@ impl Footprint {
     #[inline]
     fn index_of(&self, p: DVec2) -> (i64, i64) {
         (
-            libm::floor(p.x / self.cell) as i64,
-            libm::floor(p.y / self.cell) as i64,
+            crate::hash::floor_i64(p.x / self.cell),
+            crate::hash::floor_i64(p.y / self.cell),
         )
     }
 
@@ -134,9 +134,9 @@ impl Footprint {
             && self.get_local(x as usize, y as usize)
     }
 
-    /// Set the cells of all `points` (frame coordinates, metres). Non-finite
-    /// points are ignored.
-    pub fn mark_all(&mut self, points: &[DVec2]) {
+    /// Set the cells of all `points` (frame coordinates, metres); returns
+    /// how many cells were newly set. Non-finite points are ignored.
+    pub fn mark_all(&mut self, points: &[DVec2]) -> usize {
         let mut lo = (i64::MAX, i64::MAX);
         let mut hi = (i64::MIN, i64::MIN);
         for &p in points {
@@ -148,17 +148,20 @@ impl Footprint {
             hi = (hi.0.max(x), hi.1.max(y));
         }
         if lo.0 > hi.0 {
-            return;
+            return 0;
         }
         self.grow_to(lo, hi);
+        let mut fresh = 0;
         for &p in points {
             if !p.is_finite() {
                 continue;
             }
             let (x, y) = self.index_of(p);
             let k = (y - self.y0) as usize * self.w + (x - self.x0) as usize;
+            fresh += (self.bits[k >> 6] >> (k & 63) & 1 == 0) as usize;
             self.bits[k >> 6] |= 1 << (k & 63);
         }
+        fresh
     }
 
     /// Number of set cells.
@@ -284,7 +287,7 @@ impl Footprint {
     /// frames).
     pub fn merge_mapped(&mut self, other: &Footprint, map: impl Fn(DVec2) -> DVec2) {
         let pts: Vec<DVec2> = other.cell_centres().into_iter().map(map).collect();
-        self.mark_all(&pts);
+        let _ = self.mark_all(&pts);
     }
 }
 
@@ -306,8 +309,8 @@ impl Region {
     /// Does the footprint cell under `p` belong to the region? Uses the
     /// footprint's own cell indexing, so it agrees exactly with `mark_all`.
     pub fn contains(&self, p: DVec2) -> bool {
-        let ix = libm::floor(p.x / self.cell) as i64;
-        let iy = libm::floor(p.y / self.cell) as i64;
+        let ix = crate::hash::floor_i64(p.x / self.cell);
+        let iy = crate::hash::floor_i64(p.y / self.cell);
         let x = (ix - self.base.0).div_euclid(self.factor) + self.margin;
         let y = (iy - self.base.1).div_euclid(self.factor) + self.margin;
         x >= 0
@@ -345,12 +348,11 @@ fn trace_region(
     r: usize,
 ) -> Option<(Vec<(i64, i64)>, Vec<bool>)> {
     let closed = if r > 0 {
-        let r2 = (r * r) as f64;
-        let dil: Vec<bool> = sq_edt(&grid, w, h).into_iter().map(|d| d <= r2).collect();
+        let dil = dilate_disk(&grid, w, h, r as f64);
         let outside: Vec<bool> = dil.iter().map(|&b| !b).collect();
-        sq_edt(&outside, w, h)
+        dilate_disk(&outside, w, h, r as f64)
             .into_iter()
-            .map(|d| d > r2)
+            .map(|b| !b)
             .collect::<Vec<bool>>()
     } else {
         grid
@@ -469,8 +471,55 @@ fn neighbours4(k: usize, w: usize, h: usize) -> impl Iterator<Item = usize> {
     .flatten()
 }
 
+/// Cells whose centre lies within `radius` cells of the centre of a set cell
+/// (binary dilation by a disk). Exact: per row the distance to the nearest
+/// set cell in that row is computed in two sweeps, then each cell looks at
+/// the `2r + 1` rows around it: `O(cells * r)` integer work, far cheaper
+/// than a full distance transform for the small radii used here.
+pub(crate) fn dilate_disk(grid: &[bool], w: usize, h: usize, radius: f64) -> Vec<bool> {
+    let r = radius.max(0.0).floor() as usize;
+    let cap = (r + 1) as u32;
+    let mut hd = vec![cap; w * h];
+    for y in 0..h {
+        let row = &grid[y * w..(y + 1) * w];
+        let out = &mut hd[y * w..(y + 1) * w];
+        let mut last = cap;
+        for x in 0..w {
+            last = if row[x] { 0 } else { (last + 1).min(cap) };
+            out[x] = last;
+        }
+        last = cap;
+        for x in (0..w).rev() {
+            last = if row[x] { 0 } else { (last + 1).min(cap) };
+            out[x] = out[x].min(last);
+        }
+    }
+    let lim = radius * radius;
+    let mut out = vec![false; w * h];
+    for y in 0..h {
+        let y0 = y.saturating_sub(r);
+        let y1 = (y + r).min(h - 1);
+        for x in 0..w {
+            let mut hit = false;
+            for yy in y0..=y1 {
+                let dx = hd[yy * w + x];
+                if dx <= r as u32 {
+                    let dy = yy as f64 - y as f64;
+                    if (dx * dx) as f64 + dy * dy <= lim {
+                        hit = true;
+                        break;
+                    }
+                }
+            }
+            out[y * w + x] = hit;
+        }
+    }
+    out
+}
+
 /// Exact squared Euclidean distance (in cells) from every cell to the nearest
 /// set cell (Felzenszwalb–Huttenlocher, separable, linear time).
+#[cfg(test)]
 fn sq_edt(grid: &[bool], w: usize, h: usize) -> Vec<f64> {
     const INF: f64 = 1e20;
     let mut d: Vec<f64> = grid.iter().map(|&b| if b { 0.0 } else { INF }).collect();
@@ -498,6 +547,7 @@ fn sq_edt(grid: &[bool], w: usize, h: usize) -> Vec<f64> {
     d
 }
 
+#[cfg(test)]
 fn edt_1d(f: &[f64], out: &mut [f64], v: &mut [usize], z: &mut [f64]) {
     let n = f.len();
     if n == 0 {
@@ -574,6 +624,19 @@ mod tests {
                 })
                 .fold(f64::INFINITY, f64::min);
             assert_eq!(d[k], best);
+        }
+    }
+
+    #[test]
+    fn disk_dilation_matches_the_distance_transform() {
+        let (w, h) = (23, 17);
+        let grid: Vec<bool> = (0..w * h).map(|k| k % 11 == 0 || k == 100 || k == 101).collect();
+        let d = sq_edt(&grid, w, h);
+        for radius in [0.0, 1.0, 1.5, 2.0, 3.7, 6.0] {
+            let dil = dilate_disk(&grid, w, h, radius);
+            for k in 0..w * h {
+                assert_eq!(dil[k], d[k] <= radius * radius, "radius {radius} cell {k}");
+            }
         }
     }
 

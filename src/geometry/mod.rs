@@ -4,6 +4,7 @@
 
 pub mod footprint;
 pub mod hull;
+pub mod mask;
 pub mod plane;
 pub mod polygon;
 

@@ -41,12 +41,15 @@ impl Plane {
     }
 
     /// The same plane with the normal flipped when needed so that it points
-    /// towards `viewpoint`; near-horizontal planes (within `max_tilt`) point up.
-    pub fn oriented(self, viewpoint: DVec3, max_tilt: f64) -> Self {
-        let flip = if self.is_horizontal(max_tilt) {
-            self.normal.dot(UP) < 0.0
+    /// towards `viewpoint` (the side the sensor saw it from). A plane through
+    /// the viewpoint itself keeps a normal pointing up (or is left as is
+    /// when vertical).
+    pub fn oriented(self, viewpoint: DVec3) -> Self {
+        let sd = self.signed_distance(viewpoint);
+        let flip = if sd.abs() > 1e-9 {
+            sd < 0.0
         } else {
-            self.signed_distance(viewpoint) < 0.0
+            self.normal.dot(UP) < 0.0
         };
         if flip {
             Plane {

@@ -93,14 +93,6 @@ pub fn check_invariants(cloud: &Cloud, det: &Detection, p: &Params) {
         assert!(signed_area(&prim.outline) > 0.0, "outline of {i} not ccw");
         assert!((signed_area(&prim.outline) - prim.area).abs() < 1e-6 * prim.area.max(1.0));
     }
-    // Concave outlines pass through the centres of the boundary raster cells
-    // and are simplified: support may stick out by half a cell plus the
-    // simplification tolerance. Convex hulls contain their support exactly
-    // (unless capped at max_vertices, then within the tolerance).
-    let tol_out = match p.hull {
-        HullKind::Convex => 1e-6 + p.simplify,
-        HullKind::Concave => 0.5 * p.cell + p.simplify + 1e-6,
-    };
     for (i, &l) in det.labels.iter().enumerate() {
         if l == NO_PRIMITIVE {
             continue;
@@ -115,6 +107,15 @@ pub fn check_invariants(cloud: &Cloud, det: &Detection, p: &Params) {
         };
         let d = prim.plane.signed_distance(w).abs();
         assert!(d < thr, "point {i} is {d} m from plane of {l}");
+        // Concave outlines pass through the centres of the boundary raster
+        // cells and are simplified: support may stick out by up to one raster
+        // cell plus the simplification tolerance (the documented resolution).
+        // Convex hulls contain their support exactly (unless capped at
+        // max_vertices, then within the tolerance).
+        let tol_out = match p.hull {
+            HullKind::Convex => 1e-6 + p.simplify,
+            HullKind::Concave => prim.footprint.cell() + p.simplify + 1e-6,
+        };
         let q = prim.frame.to_local(w);
         let out = distance(&prim.outline, q);
         assert!(

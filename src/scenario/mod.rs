@@ -1,0 +1,219 @@
+//! The incremental scenario: scans arrive one at a time and update a live
+//! list of primitives (the paper's Algorithm 2, plus merging).
+//!
+//! Per scan: transform to the world frame (f64, around a local origin),
+//! expand every existing primitive in a cascade, detect new primitives on
+//! what is left, merge primitives that grew into each other, report.
+
+mod expand;
+mod index;
+mod merge;
+
+pub use merge::MergeEvent;
+
+use crate::clock;
+use crate::cloud::Cloud;
+use crate::detect::{Detector, NO_PRIMITIVE};
+use crate::error::{Error, Result};
+use crate::params::Params;
+use crate::primitive::Primitive;
+use crate::rng::Rng;
+use glam::{DMat4, DVec3};
+use index::ScanIndex;
+use serde::{Deserialize, Serialize};
+
+/// Voxel side of the per-scan index (m).
+const INDEX_VOXEL: f64 = 1.0;
+
+/// Time per stage of one scan (ms).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct StageTimes {
+    /// Expanding existing primitives.
+    pub expansion: f64,
+    /// Detecting new ones on the leftover points.
+    pub detection: f64,
+    /// Merging.
+    pub merge: f64,
+    /// The whole update, transform included.
+    pub total: f64,
+}
+
+/// What one scan did to the scenario.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct ScanReport {
+    /// Scan number (0 for the first).
+    pub scan: u64,
+    /// Points in the scan.
+    pub points: usize,
+    /// Points taken by the expansion of existing primitives.
+    pub explained_by_expansion: usize,
+    /// Points given to detection (the rest).
+    pub sent_to_detection: usize,
+    /// Ids of new primitives.
+    pub added: Vec<u32>,
+    /// Ids of existing primitives that grew.
+    pub grown: Vec<u32>,
+    /// Merges made.
+    pub merged: Vec<MergeEvent>,
+    /// Primitives after the scan.
+    pub polygon_count: usize,
+    /// Total outline area after the scan (m^2).
+    pub total_area: f64,
+    /// Time per stage (ms).
+    pub time_ms: StageTimes,
+}
+
+/// The live scenario. Holds parameters, primitives (sorted by id) and
+/// counters; its size grows with the mapped area, not with the number of
+/// scans (primitives keep running moments and a footprint raster, never
+/// their points).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct Scenario {
+    params: Params,
+    primitives: Vec<Primitive>,
+    next_id: u32,
+    scans: u64,
+    #[serde(skip)]
+    last_labels: Vec<u32>,
+}
+
+impl Scenario {
+    /// An empty scenario. Errors on invalid parameters.
+    pub fn new(params: Params) -> Result<Self> {
+        params.validate()?;
+        Ok(Scenario {
+            params,
+            primitives: Vec::new(),
+            next_id: 0,
+            scans: 0,
+            last_labels: Vec::new(),
+        })
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &Params {
+        &self.params
+    }
+
+    /// The primitives, sorted by id.
+    pub fn primitives(&self) -> &[Primitive] {
+        &self.primitives
+    }
+
+    /// Scans processed so far.
+    pub fn scans(&self) -> u64 {
+        self.scans
+    }
+
+    /// Per point of the last scan: the id of the primitive that explained it
+    /// (by expansion or detection; after merges, the surviving id), or
+    /// [`NO_PRIMITIVE`].
+    pub fn last_labels(&self) -> &[u32] {
+        &self.last_labels
+    }
+
+    /// Add a scan: `points` interleaved with `stride` 3 or 4 in the sensor
+    /// frame, `pose` the world-from-sensor rigid transform.
+    pub fn add_scan(&mut self, points: &[f32], stride: usize, pose: &DMat4) -> Result<ScanReport> {
+        let t0 = clock::now_ms();
+        let cloud = Cloud::from_sensor(points, stride, pose)?;
+        let sensor = pose.w_axis.truncate();
+        Ok(self.add_cloud(&cloud, sensor, t0))
+    }
+
+    /// Add a scan already in the world frame (`cloud`), seen from `sensor`
+    /// (world position, used to orient new normals). `t0` is the clock
+    /// reading the total time counts from.
+    pub fn add_cloud(&mut self, cloud: &Cloud, sensor: DVec3, t0: f64) -> ScanReport {
+        let p = &self.params;
+        let scan = self.scans;
+        let n = cloud.len();
+        let mut labels = vec![NO_PRIMITIVE; n];
+        let mut alive = vec![true; n];
+        let mut report = ScanReport {
+            scan,
+            points: n,
+            ..ScanReport::default()
+        };
+
+        // 1. Expansion of existing primitives, in a cascade (id order).
+        let te = clock::now_ms();
+        if p.expansion && !self.primitives.is_empty() && n > 0 {
+            let mut index = ScanIndex::new(&cloud.points, INDEX_VOXEL);
+            for (k, prim) in self.primitives.iter_mut().enumerate() {
+                let stamp = k as u32 + 1;
+                let taken =
+                    expand::expand(prim, cloud, &mut index, stamp, &mut alive, &mut labels, p, scan);
+                if taken > 0 {
+                    report.grown.push(prim.id);
+                    report.explained_by_expansion += taken;
+                }
+            }
+        }
+        report.time_ms.expansion = clock::now_ms() - te;
+
+        // 2. Detection on the leftover points.
+        let td = clock::now_ms();
+        let rest: Vec<u32> = (0..n as u32).filter(|&i| alive[i as usize]).collect();
+        report.sent_to_detection = rest.len();
+        let pts: Vec<glam::Vec3> = rest.iter().map(|&i| cloud.points[i as usize]).collect();
+        let det =
+            Detector::new(p).run_with_rng(&pts, cloud.origin, sensor, Rng::derive(p.seed, scan));
+        for mut prim in det.primitives {
+            let local = prim.id;
+            prim.id = self.next_id;
+            self.next_id += 1;
+            prim.born_scan = scan;
+            prim.last_scan = scan;
+            for (k, &l) in det.labels.iter().enumerate() {
+                if l == local {
+                    labels[rest[k] as usize] = prim.id;
+                }
+            }
+            report.added.push(prim.id);
+            self.primitives.push(prim);
+        }
+        report.time_ms.detection = clock::now_ms() - td;
+
+        // 3. Merge primitives that now touch (never in the paper's mode
+        //    without expansion, which appends).
+        let tm = clock::now_ms();
+        if p.expansion {
+            let mut changed = report.grown.clone();
+            changed.extend_from_slice(&report.added);
+            report.merged = merge::merge_all(&mut self.primitives, &changed, p);
+            for ev in &report.merged {
+                for l in labels.iter_mut().filter(|l| **l == ev.removed) {
+                    *l = ev.kept;
+                }
+                report.grown.retain(|&g| g != ev.removed);
+                report.added.retain(|&a| a != ev.removed);
+            }
+        }
+        report.time_ms.merge = clock::now_ms() - tm;
+
+        self.scans += 1;
+        report.polygon_count = self.primitives.len();
+        report.total_area = self.primitives.iter().map(|q| q.area).sum();
+        report.time_ms.total = clock::now_ms() - t0;
+        self.last_labels = labels;
+        report
+    }
+
+    /// The whole state as JSON (parameters included). Restoring it with
+    /// [`Scenario::from_json`] and continuing gives exactly the result of
+    /// not stopping.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string(self).unwrap_or_default()
+    }
+
+    /// Restore from [`Scenario::to_json`] output.
+    pub fn from_json(text: &str) -> Result<Self> {
+        let s: Scenario = serde_json::from_str(text)
+            .map_err(|e| Error::Invalid(format!("not a polyscene snapshot: {e}")))?;
+        s.params.validate()?;
+        Ok(s)
+    }
+}
