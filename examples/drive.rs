@@ -2,11 +2,25 @@ use polyscene::params::Params;
 use polyscene::scenario::Scenario;
 use polyscene::sim::{Drive, DriveOptions, Layout, SensorModel};
 fn main() {
-    let layout: Layout = std::env::args().nth(1).unwrap_or("street".into()).parse().unwrap();
-    let scans: usize = std::env::args().nth(2).map(|s| s.parse().unwrap()).unwrap_or(60);
-    let expansion = std::env::args().nth(3).map(|s| s != "noexp").unwrap_or(true);
+    let layout: Layout = std::env::args()
+        .nth(1)
+        .unwrap_or("street".into())
+        .parse()
+        .unwrap();
+    let scans: usize = std::env::args()
+        .nth(2)
+        .map(|s| s.parse().unwrap())
+        .unwrap_or(60);
+    let expansion = std::env::args()
+        .nth(3)
+        .map(|s| s != "noexp")
+        .unwrap_or(true);
     let drive = Drive::new(layout, 1, SensorModel::default(), DriveOptions::default()).unwrap();
-    let mut sc = Scenario::new(Params { expansion, ..Params::gpp2() }).unwrap();
+    let mut sc = Scenario::new(Params {
+        expansion,
+        ..Params::gpp2()
+    })
+    .unwrap();
     let mut times = vec![];
     for k in 0..scans.min(drive.len()) {
         let t = std::time::Instant::now();

@@ -247,7 +247,11 @@ pub(crate) fn shape(
         .zip(&near)
         .filter_map(|(&p, &k)| k.then_some(p))
         .collect();
-    let cell = if ground { params.ground_cell } else { params.cell };
+    let cell = if ground {
+        params.ground_cell
+    } else {
+        params.cell
+    };
     let mut footprint = Footprint::new(cell);
     footprint.mark_all(&q_near);
     let (outline, kept) = match params.hull {

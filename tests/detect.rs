@@ -88,7 +88,12 @@ fn box_room_gives_six_faces() {
             assert!(q.plane.signed_distance(centre) > 0.0);
         }
         // Only the floor is ground: the ceiling is above the sensor.
-        let ground: Vec<f64> = det.primitives.iter().filter(|q| q.ground).map(|q| q.plane.offset).collect();
+        let ground: Vec<f64> = det
+            .primitives
+            .iter()
+            .filter(|q| q.ground)
+            .map(|q| q.plane.offset)
+            .collect();
         assert_eq!(ground.len(), 1);
         assert!(ground[0].abs() < 0.02);
         // Most points are explained.

@@ -158,7 +158,11 @@ fn replay_cmd(args: &mut Args) -> Result<String> {
         std::fs::write(&path, lines).map_err(|e| Error::Io(format!("cannot write {path}: {e}")))?;
     }
     let doc = PolygonsJson {
-        polygons: scenario.primitives().iter().map(PolygonJson::from).collect(),
+        polygons: scenario
+            .primitives()
+            .iter()
+            .map(PolygonJson::from)
+            .collect(),
         time_ms: total_ms,
     };
     write_or_return(&doc, out)
@@ -172,7 +176,13 @@ fn simulate_cmd(args: &mut Args) -> Result<String> {
         .take("out")
         .ok_or_else(|| Error::Invalid("simulate needs --out DIR".into()))?;
     args.finish()?;
-    crate::sim::write_dataset(Path::new(&out), layout, seed, scans, &crate::sim::SensorModel::default())?;
+    crate::sim::write_dataset(
+        Path::new(&out),
+        layout,
+        seed,
+        scans,
+        &crate::sim::SensorModel::default(),
+    )?;
     Ok(String::new())
 }
 
@@ -198,7 +208,11 @@ fn eval_cmd(args: &mut Args) -> Result<String> {
         .polygons
         .iter()
         .filter_map(|p| {
-            let v: Vec<glam::DVec3> = p.vertices.iter().map(|&a| glam::DVec3::from_array(a)).collect();
+            let v: Vec<glam::DVec3> = p
+                .vertices
+                .iter()
+                .map(|&a| glam::DVec3::from_array(a))
+                .collect();
             crate::geometry::Polygon3::from_world(&v)
         })
         .collect();
@@ -221,11 +235,22 @@ fn eval_cmd(args: &mut Args) -> Result<String> {
             continue;
         };
         for (p, &lab) in scan.points.chunks_exact(4).zip(l) {
-            points.push(pose.transform_point3(glam::DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)));
+            points.push(pose.transform_point3(glam::DVec3::new(
+                p[0] as f64,
+                p[1] as f64,
+                p[2] as f64,
+            )));
             labels.push(lab);
         }
     }
     let n = data.scans.iter().map(|s| s.points.len() / 4).sum();
-    let metrics = crate::eval::evaluate(&pred, &surfaces, &points, &labels, n, &crate::eval::EvalOptions::default())?;
+    let metrics = crate::eval::evaluate(
+        &pred,
+        &surfaces,
+        &points,
+        &labels,
+        n,
+        &crate::eval::EvalOptions::default(),
+    )?;
     Ok(metrics.to_string())
 }

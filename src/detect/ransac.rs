@@ -159,7 +159,11 @@ impl<'a> PlanePool<'a> {
     /// `min_inliers`.
     /// `viewpoint` is the sensor in local coordinates: horizontal planes at
     /// least `ground_depth` below it are counted with the ground distance.
-    pub fn best_plane(&mut self, params: &Params, viewpoint: DVec3) -> Option<(LocalPlane, Vec<u32>)> {
+    pub fn best_plane(
+        &mut self,
+        params: &Params,
+        viewpoint: DVec3,
+    ) -> Option<(LocalPlane, Vec<u32>)> {
         let n = self.remaining();
         if n < params.min_inliers.max(3) {
             return None;

@@ -630,7 +630,9 @@ mod tests {
     #[test]
     fn disk_dilation_matches_the_distance_transform() {
         let (w, h) = (23, 17);
-        let grid: Vec<bool> = (0..w * h).map(|k| k % 11 == 0 || k == 100 || k == 101).collect();
+        let grid: Vec<bool> = (0..w * h)
+            .map(|k| k % 11 == 0 || k == 100 || k == 101)
+            .collect();
         let d = sq_edt(&grid, w, h);
         for radius in [0.0, 1.0, 1.5, 2.0, 3.7, 6.0] {
             let dil = dilate_disk(&grid, w, h, radius);

@@ -105,7 +105,15 @@ impl GrownMask {
             let grown = dilate_disk(&grid, w, h, r + std::f64::consts::FRAC_1_SQRT_2);
             grid.iter()
                 .zip(grown)
-                .map(|(&g, d)| if g { 0 } else if d { 1 } else { 2 })
+                .map(|(&g, d)| {
+                    if g {
+                        0
+                    } else if d {
+                        1
+                    } else {
+                        2
+                    }
+                })
                 .collect()
         } else {
             grid.into_iter().map(|g| if g { 0 } else { 2 }).collect()

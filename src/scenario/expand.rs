@@ -225,4 +225,3 @@ fn bounds(pts: &[DVec3]) -> (DVec3, DVec3) {
     }
     (lo, hi)
 }
-

@@ -122,8 +122,9 @@ impl ScanIndex {
             return;
         }
         let v = self.voxel;
-        let clamp =
-            |x: f64, k: usize| -> i64 { crate::hash::floor_i64(x / v).clamp(self.lo[k], self.hi[k]) };
+        let clamp = |x: f64, k: usize| -> i64 {
+            crate::hash::floor_i64(x / v).clamp(self.lo[k], self.hi[k])
+        };
         let (blo, bhi) = (
             [clamp(lo.x, 0), clamp(lo.y, 1), clamp(lo.z, 2)],
             [clamp(hi.x, 0), clamp(hi.y, 1), clamp(hi.z, 2)],

@@ -144,8 +144,16 @@ impl Scenario {
             let mut index = ScanIndex::new(&cloud.points, INDEX_VOXEL);
             for (k, prim) in self.primitives.iter_mut().enumerate() {
                 let stamp = k as u32 + 1;
-                let taken =
-                    expand::expand(prim, cloud, &mut index, stamp, &mut alive, &mut labels, p, scan);
+                let taken = expand::expand(
+                    prim,
+                    cloud,
+                    &mut index,
+                    stamp,
+                    &mut alive,
+                    &mut labels,
+                    p,
+                    scan,
+                );
                 if taken > 0 {
                     report.grown.push(prim.id);
                     report.explained_by_expansion += taken;
