@@ -16,10 +16,13 @@ pub mod eval;
 pub mod geometry;
 pub mod hash;
 pub mod io;
+pub mod mesh;
 pub mod params;
 pub mod primitive;
 pub mod rng;
 pub mod scenario;
 pub mod sim;
+#[cfg(target_arch = "wasm32")]
+pub mod wasm;
 
 pub use error::{Error, Result};

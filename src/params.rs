@@ -48,15 +48,15 @@ pub struct Params {
     /// Inlier distance to a plane for non-ground planes (m). Default 0.10
     /// (authors: 0.2, for noisier data; 0.2 swallows curbs and door recesses).
     pub distance: f64,
-    /// Inlier distance for near-horizontal (ground) planes (m). Default 0.10
-    /// (authors: 0.3; that merges the road with 0.15 m high sidewalks).
+    /// Inlier distance for ground planes (m). Default 0.08, below half a
+    /// curb (authors: 0.3, which merges the road with 0.15 m high sidewalks).
     pub ground_distance: f64,
     /// Largest tilt from horizontal for a plane to count as ground (deg).
     /// Default 15.
     pub ground_max_tilt: f64,
     /// Ground lies at least this far below the sensor (m); a horizontal
-    /// plane higher up (a car roof, a table) is an ordinary primitive.
-    /// Default 1.0.
+    /// plane higher up (a car's roof or bonnet, a table) is an ordinary
+    /// primitive. Default 1.3 (sensors on a car roof sit 1.7-2 m up).
     pub ground_depth: f64,
     /// Sensor position for one-shot detection (world, m): normals of
     /// non-horizontal planes point towards it, and it decides what is
@@ -118,13 +118,19 @@ pub struct Params {
     /// points spread evenly through the inlier slab (a plane slicing through
     /// objects) give about 0.58. Default 0.45.
     pub max_roughness: f64,
+    /// Least share of the support's local patches (cells of `2 * cell`)
+    /// whose own normal agrees with the plane's within 15 degrees. A plane
+    /// cutting through crossing surfaces (a horizontal slab through parked
+    /// cars' sides) collects points whose local normals are perpendicular to
+    /// it. Default 0.6.
+    pub min_normal_consistency: f64,
     /// Which solidity test to apply. Default occupancy.
     pub solidity: SolidityKind,
     /// Least support points per m^2 with `solidity: density`. Default 48
     /// (authors).
     pub min_density: f64,
     /// Least occupied share of the area with `solidity: occupancy` (0..1).
-    /// Default 0.3.
+    /// Default 0.5.
     pub min_occupancy: f64,
 
     // --- Cascade budget ---
@@ -160,7 +166,9 @@ pub struct Params {
     /// Largest angle between two primitives' planes for a merge (deg).
     /// Default 8.
     pub merge_angle: f64,
-    /// Largest plane-to-plane distance for a merge (m). Default 0.12.
+    /// Largest RMS distance of the smaller primitive's outline vertices and
+    /// centroid from the larger one's plane for a merge (m); keep it below
+    /// the height of a curb. Default 0.08.
     pub merge_distance: f64,
     /// Outlines closer than this are "touching" for a merge (m). Default 0.3.
     pub merge_gap: f64,
@@ -177,9 +185,9 @@ impl Params {
     pub fn gpp2() -> Self {
         Params {
             distance: 0.10,
-            ground_distance: 0.10,
+            ground_distance: 0.08,
             ground_max_tilt: 15.0,
-            ground_depth: 1.0,
+            ground_depth: 1.3,
             viewpoint: [0.0; 3],
             min_inliers: 150,
             max_hypotheses: 400,
@@ -189,17 +197,18 @@ impl Params {
             cluster_tolerance: 0.5,
             hull: HullKind::Concave,
             alpha: 0.5,
-            ground_alpha: 1.5,
+            ground_alpha: 1.0,
             cell: 0.2,
-            ground_cell: 0.4,
+            ground_cell: 0.2,
             simplify: 0.1,
             max_vertices: 64,
             min_area: 1.5,
             min_width: 0.4,
             max_roughness: 0.45,
+            min_normal_consistency: 0.6,
             solidity: SolidityKind::Occupancy,
             min_density: 48.0,
-            min_occupancy: 0.3,
+            min_occupancy: 0.5,
             max_primitives: 200,
             max_rejections: 24,
             max_work: 2_000_000_000,
@@ -209,7 +218,7 @@ impl Params {
             expand_across: 0.08,
             expand_along: 0.6,
             merge_angle: 8.0,
-            merge_distance: 0.12,
+            merge_distance: 0.08,
             merge_gap: 0.3,
         }
     }
@@ -234,6 +243,79 @@ impl Params {
                 reason: format!("unknown preset '{other}', expected 'gpp1' or 'gpp2'"),
             }),
         }
+    }
+
+    /// The option keys, camelCase as in JSON and the JS options (`preset`
+    /// not included), sorted.
+    pub fn keys() -> Vec<String> {
+        match serde_json::to_value(Params::gpp2()) {
+            Ok(serde_json::Value::Object(map)) => map.keys().cloned().collect(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// Parameters from an options object (the JS options): start from the
+    /// preset named by the `preset` key (default `"gpp2"`), override it with
+    /// every other key, then [`Params::validate`]. An unknown key, a value of
+    /// the wrong type or out of range is an [`Error::BadOption`] naming the
+    /// key.
+    ///
+    /// ```
+    /// use polyscene::params::Params;
+    /// let opts = serde_json::json!({ "preset": "gpp1", "hull": "convex", "minArea": 3 });
+    /// let p = Params::from_options(opts.as_object().unwrap()).unwrap();
+    /// assert_eq!((p.min_area, p.min_inliers), (3.0, Params::gpp1().min_inliers));
+    /// let bad = serde_json::json!({ "minAreaa": 3 });
+    /// let e = Params::from_options(bad.as_object().unwrap()).unwrap_err();
+    /// assert!(e.to_string().contains("minAreaa"));
+    /// ```
+    pub fn from_options(options: &serde_json::Map<String, serde_json::Value>) -> Result<Params> {
+        use serde_json::Value;
+        let base = match options.get("preset") {
+            None => Params::gpp2(),
+            Some(Value::String(name)) => Params::preset(name)?,
+            Some(other) => {
+                return Err(Error::BadOption {
+                    key: "preset".into(),
+                    reason: format!("expected 'gpp1' or 'gpp2', got {other}"),
+                })
+            }
+        };
+        let Ok(Value::Object(mut merged)) = serde_json::to_value(&base) else {
+            return Err(Error::Invalid("parameters do not serialise".into()));
+        };
+        for (key, value) in options {
+            if key == "preset" {
+                continue;
+            }
+            if !merged.contains_key(key) {
+                let keys = Params::keys();
+                let hint = closest_key(key, &keys)
+                    .map(|k| format!(" (did you mean '{k}'?)"))
+                    .unwrap_or_default();
+                return Err(Error::BadOption {
+                    key: key.clone(),
+                    reason: format!(
+                        "unknown option{hint}; the options are preset, {}",
+                        keys.join(", ")
+                    ),
+                });
+            }
+            // Check this key alone (missing keys take defaults), so that a
+            // type error is attributed to it.
+            let single = serde_json::Map::from_iter([(key.clone(), value.clone())]);
+            if let Err(e) = serde_json::from_value::<Params>(Value::Object(single)) {
+                return Err(Error::BadOption {
+                    key: key.clone(),
+                    reason: plain_serde_message(&e.to_string()),
+                });
+            }
+            merged.insert(key.clone(), value.clone());
+        }
+        let params: Params = serde_json::from_value(Value::Object(merged))
+            .map_err(|e| Error::Invalid(format!("options: {e}")))?;
+        params.validate()?;
+        Ok(params)
     }
 
     /// Check every field's range; the error names the offending key (in the
@@ -288,6 +370,7 @@ impl Params {
             });
         }
         pos("maxRoughness", self.max_roughness, 10.0)?;
+        frac("minNormalConsistency", self.min_normal_consistency, false)?;
         count("minInliers", self.min_inliers, 3, 100_000_000)?;
         count("maxHypotheses", self.max_hypotheses, 1, 1_000_000)?;
         frac("confidence", self.confidence, true)?;
@@ -365,6 +448,48 @@ impl Params {
     }
 }
 
+/// The known key an unknown `key` was probably meant to be: the same up to
+/// case and `_`/`-` (`min_area` for `minArea`), or at most two edits away.
+fn closest_key<'a>(key: &str, keys: &'a [String]) -> Option<&'a str> {
+    let norm = |s: &str| -> Vec<char> {
+        s.chars()
+            .filter(|c| *c != '_' && *c != '-')
+            .flat_map(char::to_lowercase)
+            .collect()
+    };
+    let edits = |a: &[char], b: &[char]| {
+        let mut row: Vec<usize> = (0..=b.len()).collect();
+        for (i, ca) in a.iter().enumerate() {
+            let mut prev = row[0];
+            row[0] = i + 1;
+            for (j, cb) in b.iter().enumerate() {
+                let cur = row[j + 1];
+                row[j + 1] = (prev + usize::from(ca != cb)).min(row[j] + 1).min(cur + 1);
+                prev = cur;
+            }
+        }
+        row[b.len()]
+    };
+    let k = norm(key);
+    keys.iter()
+        .map(|c| (edits(&k, &norm(c)), c))
+        .filter(|(d, _)| *d <= 2)
+        .min_by_key(|(d, _)| *d)
+        .map(|(_, c)| c.as_str())
+}
+
+/// A serde type error in the words of the options' documentation.
+fn plain_serde_message(msg: &str) -> String {
+    msg.replace("expected f64", "expected a number")
+        .replace("expected u64", "expected a non-negative integer")
+        .replace("expected usize", "expected a non-negative integer")
+        .replace("expected a boolean", "expected true or false")
+        .replace(
+            "expected an array of length 3",
+            "expected an array of 3 numbers",
+        )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -389,6 +514,81 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("minOccupancy"));
+    }
+
+    #[test]
+    fn options_merge_over_the_preset_and_errors_name_the_key() {
+        let opts = |v: serde_json::Value| Params::from_options(v.as_object().unwrap());
+        assert_eq!(opts(serde_json::json!({})).unwrap(), Params::gpp2());
+        assert_eq!(
+            opts(serde_json::json!({"preset": "gpp1"})).unwrap(),
+            Params::gpp1()
+        );
+        let p = opts(serde_json::json!({
+            "preset": "gpp1", "hull": "convex", "minArea": 3, "seed": 9,
+            "viewpoint": [1, 2.5, 3], "expansion": false, "solidity": "density"
+        }))
+        .unwrap();
+        assert_eq!(
+            p,
+            Params {
+                hull: HullKind::Convex,
+                min_area: 3.0,
+                seed: 9,
+                viewpoint: [1.0, 2.5, 3.0],
+                expansion: false,
+                solidity: SolidityKind::Density,
+                ..Params::gpp1()
+            }
+        );
+        for (bad, key, words) in [
+            (serde_json::json!({"preset": "gpp3"}), "preset", "gpp3"),
+            (serde_json::json!({"preset": 1}), "preset", "gpp1"),
+            (
+                serde_json::json!({"minAreaa": 1}),
+                "minAreaa",
+                "did you mean 'minArea'",
+            ),
+            (
+                serde_json::json!({"min_area": 1}),
+                "min_area",
+                "did you mean 'minArea'",
+            ),
+            (
+                serde_json::json!({"colour": 1}),
+                "colour",
+                "unknown option; the options",
+            ),
+            (
+                serde_json::json!({"minArea": "big"}),
+                "minArea",
+                "expected a number",
+            ),
+            (serde_json::json!({"minArea": -1}), "minArea", ">= 0"),
+            (
+                serde_json::json!({"minInliers": 2.5}),
+                "minInliers",
+                "integer",
+            ),
+            (serde_json::json!({"seed": -1}), "seed", "integer"),
+            (serde_json::json!({"hull": "round"}), "hull", "concave"),
+            (
+                serde_json::json!({"expansion": 1}),
+                "expansion",
+                "true or false",
+            ),
+            (serde_json::json!({"viewpoint": [1, 2]}), "viewpoint", "3"),
+            (serde_json::json!({"distance": null}), "distance", "null"),
+        ] {
+            let e = opts(bad.clone()).unwrap_err().to_string();
+            assert!(e.contains(&format!("'{key}'")), "{bad}: {e}");
+            assert!(e.contains(words), "{bad}: {e}");
+        }
+        // Every field is an option key (serde_json of the struct lists them).
+        let keys = Params::keys();
+        let fields = serde_json::to_value(Params::gpp2()).unwrap();
+        assert_eq!(keys.len(), fields.as_object().unwrap().len());
+        assert!(keys.contains(&"groundExpandAcross".to_string()));
     }
 
     #[test]

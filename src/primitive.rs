@@ -79,19 +79,14 @@ impl Primitive {
             .map_or(0.0, |(_, vals)| vals[0].max(0.0).sqrt())
     }
 
-    /// Does it pass the acceptance tests: at least `min_inliers` support
-    /// points, area above `min_area`, width above `min_width`, roughness
-    /// below `max_roughness`, solidity?
+    /// Does it pass the acceptance tests on its shape: at least
+    /// `min_inliers` support points, area above `min_area`, width above
+    /// `min_width`, solidity? (Detection also tests the support's roughness,
+    /// which needs the points.)
     pub fn acceptable(&self, params: &Params) -> bool {
-        let distance = if self.ground {
-            params.ground_distance
-        } else {
-            params.distance
-        };
         self.support >= params.min_inliers as u64
             && self.area >= params.min_area
             && min_width(&self.outline) >= params.min_width
-            && self.rms() <= params.max_roughness * distance
             && match params.solidity {
                 SolidityKind::Density => self.density() >= params.min_density,
                 SolidityKind::Occupancy => self.occupancy() >= params.min_occupancy,
@@ -164,6 +159,61 @@ fn cap_convex(h: Vec<DVec2>, params: &Params) -> Vec<DVec2> {
 pub(crate) struct Shaped {
     pub primitive: Primitive,
     pub kept: Vec<bool>,
+    /// RMS distance of all kept support points from the plane (m), as a
+    /// share of the inlier distance: ~0.58 for points spread evenly through
+    /// the inlier slab (a plane cutting through objects), far less for a
+    /// surface.
+    pub roughness: f64,
+    /// Share of the support's local patches (cells of `2 x cell`) whose own
+    /// PCA normal lies within 15 degrees of the plane's: ~1 for a surface,
+    /// low for a plane cutting through crossing surfaces (a horizontal slab
+    /// through a car's sides, whose laser rings look flat from afar, or a
+    /// plane tilted across a curb). 1 when no patch has a well-defined
+    /// normal.
+    pub consistency: f64,
+}
+
+/// See [`Shaped::consistency`].
+fn normal_consistency(origin: DVec3, pts: &[Vec3], kept: &[bool], frame: &Frame, cell: f64) -> f64 {
+    let mut cells: crate::hash::GridMap<u64, Moments> = crate::hash::GridMap::default();
+    let mut order: Vec<u64> = Vec::new();
+    for (p, _) in pts.iter().zip(kept).filter(|(_, &k)| k) {
+        let w = origin + p.as_dvec3();
+        let q = frame.to_local(w);
+        let key = crate::hash::key2(
+            crate::hash::floor_i64(q.x / cell),
+            crate::hash::floor_i64(q.y / cell),
+        );
+        cells
+            .entry(key)
+            .or_insert_with(|| {
+                order.push(key);
+                Moments::new(w)
+            })
+            .push(w);
+    }
+    let (mut good, mut total) = (0usize, 0usize);
+    let cos_max = libm::cos(15f64.to_radians());
+    for key in order {
+        let m = &cells[&key];
+        if m.count < 6.0 {
+            continue;
+        }
+        // Only patches that are truly two-dimensional have a normal.
+        let Some((plane, vals)) = m.fit_plane() else {
+            continue;
+        };
+        if vals[1] < 0.05 * vals[2] {
+            continue;
+        }
+        total += 1;
+        good += (plane.normal.dot(frame.normal).abs() >= cos_max) as usize;
+    }
+    if total == 0 {
+        1.0
+    } else {
+        good as f64 / total as f64
+    }
 }
 
 /// PCA refit, frame, footprint, outline and area of a support set given in
@@ -190,12 +240,12 @@ pub(crate) fn shape(
     let (mut fit, _) = moments.fit_plane()?;
     // Robust refit: points of a crossing surface within the inlier distance
     // (the edge of a riser under a tread) tilt a plain least-squares plane.
-    // Refit on the points within three robust standard deviations
-    // (1.4826 x median absolute residual), twice. These points' moments are
+    // Refit on the points within 2.5 robust standard deviations
+    // (1.4826 x median absolute residual), three times. These points' moments are
     // what the primitive keeps for later refits.
     let mut resid: Vec<f64> = Vec::with_capacity(pts.len());
     let mut inner = vec![true; pts.len()];
-    for _ in 0..2 {
+    for _ in 0..3 {
         resid.clear();
         resid.extend(
             pts.iter()
@@ -204,7 +254,7 @@ pub(crate) fn shape(
         let mut sorted = resid.clone();
         let mid = sorted.len() / 2;
         let (_, med, _) = sorted.select_nth_unstable_by(mid, f64::total_cmp);
-        let cut = (3.0 * 1.4826 * *med).max(1e-4);
+        let cut = (2.5 * 1.4826 * *med).max(1e-4);
         let trimmed = moments_of(&|i| resid[i] <= cut);
         match trimmed.fit_plane() {
             Some((f, _)) if trimmed.count >= 3.0 => {
@@ -282,9 +332,17 @@ pub(crate) fn shape(
         footprint.mark_all(&q_kept);
     }
     let area = signed_area(&outline);
-    if !(area > 0.0) {
+    if area.is_nan() || area <= 0.0 {
         return None;
     }
+    let (mut sq, mut nk) = (0.0, 0usize);
+    for (p, _) in pts.iter().zip(&kept).filter(|(_, &k)| k) {
+        let d = plane.signed_distance(origin + p.as_dvec3());
+        sq += d * d;
+        nk += 1;
+    }
+    let roughness = (sq / nk.max(1) as f64).sqrt() / threshold;
+    let consistency = normal_consistency(origin, pts, &kept, &frame, 2.0 * params.cell);
     Some(Shaped {
         primitive: Primitive {
             id: 0,
@@ -300,5 +358,7 @@ pub(crate) fn shape(
             last_scan: 0,
         },
         kept,
+        roughness,
+        consistency,
     })
 }

@@ -184,7 +184,11 @@ impl<'p> Detector<'p> {
             };
             // 6. Take the support out of play (the whole cluster when rejected).
             match shaped {
-                Some(s) if s.primitive.acceptable(p) => {
+                Some(s)
+                    if s.primitive.acceptable(p)
+                        && s.roughness <= p.max_roughness
+                        && s.consistency >= p.min_normal_consistency =>
+                {
                     let id = primitives.len() as u32;
                     let taken: Vec<u32> = cluster
                         .iter()

@@ -284,7 +284,7 @@ impl<'a> PlanePool<'a> {
         let cr = (p2 - p1).cross(p3 - p1);
         let len = cr.length();
         // Twice the triangle area must exceed 1 cm^2: no near-collinear triples.
-        if !(len > 1e-4) {
+        if len.is_nan() || len <= 1e-4 {
             return None;
         }
         let nrm = cr / len;
@@ -347,22 +347,43 @@ impl<'a> PlanePool<'a> {
         out
     }
 
+    /// Robust least-squares plane of the points at these pool positions:
+    /// a PCA fit, then three refits on the points within 2.5 robust standard
+    /// deviations (1.4826 x median absolute residual) of the last plane. A
+    /// tilted hypothesis that caught a road and the edge of its sidewalk
+    /// converges to the road, the majority.
     fn refit(&self, positions: &[u32]) -> Option<LocalPlane> {
-        let r = positions[0] as usize;
-        let mut m = Moments::new(DVec3::new(
-            self.rx[r] as f64,
-            self.ry[r] as f64,
-            self.rz[r] as f64,
-        ));
-        for &p in positions {
+        let at = |p: u32| {
             let p = p as usize;
-            m.push(DVec3::new(
-                self.rx[p] as f64,
-                self.ry[p] as f64,
-                self.rz[p] as f64,
-            ));
+            DVec3::new(self.rx[p] as f64, self.ry[p] as f64, self.rz[p] as f64)
+        };
+        let reference = at(positions[0]);
+        let fit = |keep: &dyn Fn(u32) -> bool| {
+            let mut m = Moments::new(reference);
+            for &p in positions {
+                if keep(p) {
+                    m.push(at(p));
+                }
+            }
+            m.fit_plane().map(|(plane, _)| plane)
+        };
+        let mut plane = fit(&|_| true)?;
+        let mut resid: Vec<f64> = Vec::with_capacity(positions.len());
+        for _ in 0..3 {
+            resid.clear();
+            resid.extend(
+                positions
+                    .iter()
+                    .map(|&p| plane.signed_distance(at(p)).abs()),
+            );
+            let mid = resid.len() / 2;
+            let med = *resid.clone().select_nth_unstable_by(mid, f64::total_cmp).1;
+            let cut = (2.5 * 1.4826 * med).max(1e-4);
+            match fit(&|p| plane.signed_distance(at(p)).abs() <= cut) {
+                Some(next) => plane = next,
+                None => break,
+            }
         }
-        let (plane, _) = m.fit_plane()?;
         Some(LocalPlane {
             normal: plane.normal,
             offset: plane.offset,

@@ -54,7 +54,7 @@
 //!
 //! **Duplicates**: two predictions form a duplicate pair when their normals
 //! match, each one's area centroid is within `duplicate_plane_distance`
-//! (0.2 m) of the other's plane, and their overlap is more than
+//! (0.08 m) of the other's plane, and their overlap is more than
 //! `duplicate_min_overlap` (0.25 m^2). The overlap is estimated from the grid
 //! samples of the smaller polygon whose projection on the larger one's plane
 //! falls inside its outline.
@@ -98,6 +98,12 @@ pub struct GtSurface {
     pub id: u32,
     /// The surface's extent.
     pub polygon: Polygon3,
+}
+
+/// Only the duplicate check of [`evaluate`] (cheap: no sampling of ground
+/// truth), for checking a scenario after every scan.
+pub fn duplicates(pred: &[Polygon3], opts: &EvalOptions) -> Duplicates {
+    duplicates::find(pred, opts)
 }
 
 /// Evaluate predicted polygons `pred` against the ground truth `gt`, given

@@ -47,7 +47,10 @@ pub struct EvalOptions {
     /// of its area lies on one ground-truth surface. Default `0.5`.
     pub true_positive_share: f64,
     /// Duplicates: each polygon's area centroid must be within this distance
-    /// (m) of the other's plane. Default `0.2`.
+    /// (m) of the other's plane. Default `0.08`: parallel surfaces one curb
+    /// apart (0.15 m, a road and its sidewalk) or two neighbouring car roofs
+    /// of different heights are distinct surfaces, not duplicates, even where
+    /// their outlines overlap in plan view by the outline resolution.
     pub duplicate_plane_distance: f64,
     /// Duplicates: smallest overlap area (m^2) of two near-coplanar polygons
     /// reported as a duplicate pair. Default `0.25`.
@@ -67,7 +70,7 @@ impl Default for EvalOptions {
             min_observed_area: 1.0,
             on_surface_tolerance: 0.15,
             true_positive_share: 0.5,
-            duplicate_plane_distance: 0.2,
+            duplicate_plane_distance: 0.08,
             duplicate_min_overlap: 0.25,
         }
     }

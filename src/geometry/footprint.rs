@@ -24,14 +24,127 @@ use serde::{Deserialize, Serialize};
 pub const MAX_TRACE_CELLS: usize = 4_000_000;
 
 /// A growable occupancy bit grid in a plane's 2D frame.
+///
+/// Serialised as `{cell, x0, y0, w, h, bits}` with `bits` a hex string (16
+/// digits per 64-cell word): JSON numbers above 2^53 would not survive
+/// JavaScript's `JSON.parse`. Deserialising checks that the fields are
+/// consistent, so a corrupt snapshot is an error rather than a panic later.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "FootprintData")]
 pub struct Footprint {
     cell: f64,
     x0: i64,
     y0: i64,
     w: usize,
     h: usize,
+    #[serde(with = "hex_words")]
     bits: Vec<u64>,
+}
+
+/// The serialised fields of a [`Footprint`], before the consistency check.
+#[derive(Deserialize)]
+struct FootprintData {
+    cell: f64,
+    x0: i64,
+    y0: i64,
+    w: usize,
+    h: usize,
+    #[serde(with = "hex_words")]
+    bits: Vec<u64>,
+}
+
+impl TryFrom<FootprintData> for Footprint {
+    type Error = String;
+
+    fn try_from(d: FootprintData) -> Result<Self, String> {
+        // Grid sizes and offsets far beyond any real footprint (2^31 cells a
+        // side, 2^40 cells from the frame origin) would overflow later.
+        const SIDE: usize = 1 << 31;
+        const OFFSET: u64 = 1 << 40;
+        let cells = d.w.checked_mul(d.h).unwrap_or(usize::MAX);
+        let ok = d.cell.is_finite()
+            && d.cell >= 1e-3
+            && d.w <= SIDE
+            && d.h <= SIDE
+            && d.x0.unsigned_abs() <= OFFSET
+            && d.y0.unsigned_abs() <= OFFSET
+            && cells != usize::MAX
+            && (d.w == 0) == (d.h == 0)
+            && d.bits.len() == cells.div_ceil(64);
+        if !ok {
+            return Err(format!(
+                "inconsistent footprint (cell {}, {} x {} cells at ({}, {}), {} words)",
+                d.cell,
+                d.w,
+                d.h,
+                d.x0,
+                d.y0,
+                d.bits.len()
+            ));
+        }
+        Ok(Footprint {
+            cell: d.cell,
+            x0: d.x0,
+            y0: d.y0,
+            w: d.w,
+            h: d.h,
+            bits: d.bits,
+        })
+    }
+}
+
+/// Serde of `Vec<u64>` as one lowercase hex string, 16 digits per word.
+/// Reading also accepts an array of integers (the earlier format).
+mod hex_words {
+    use serde::de::{Error, SeqAccess, Visitor};
+    use serde::{Deserializer, Serializer};
+    use std::fmt;
+
+    pub fn serialize<S: Serializer>(words: &[u64], s: S) -> Result<S::Ok, S::Error> {
+        const DIGITS: &[u8; 16] = b"0123456789abcdef";
+        let mut out = String::with_capacity(16 * words.len());
+        for w in words {
+            for k in (0..16).rev() {
+                out.push(DIGITS[(w >> (4 * k) & 15) as usize] as char);
+            }
+        }
+        s.serialize_str(&out)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<u64>, D::Error> {
+        struct Words;
+        impl<'de> Visitor<'de> for Words {
+            type Value = Vec<u64>;
+
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a hex string of 16 digits per word, or an array of integers")
+            }
+
+            fn visit_str<E: Error>(self, v: &str) -> Result<Vec<u64>, E> {
+                if v.len() % 16 != 0 || !v.is_ascii() {
+                    return Err(E::custom("footprint bits: length not a multiple of 16"));
+                }
+                v.as_bytes()
+                    .chunks_exact(16)
+                    .map(|c| {
+                        std::str::from_utf8(c)
+                            .ok()
+                            .and_then(|t| u64::from_str_radix(t, 16).ok())
+                            .ok_or_else(|| E::custom("footprint bits: not hexadecimal"))
+                    })
+                    .collect()
+            }
+
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Vec<u64>, A::Error> {
+                let mut out = Vec::new();
+                while let Some(w) = seq.next_element::<u64>()? {
+                    out.push(w);
+                }
+                Ok(out)
+            }
+        }
+        d.deserialize_any(Words)
+    }
 }
 
 impl Footprint {
@@ -341,12 +454,10 @@ fn inset_rectilinear(ring: &[DVec2], d: f64) -> Vec<DVec2> {
 /// Close `grid` with a disk of radius `r` cells, keep the largest 4-connected
 /// region, fill its holes and trace its outer boundary along cell edges.
 /// Returns the ring in grid-corner coordinates and the region's cells.
-fn trace_region(
-    grid: Vec<bool>,
-    w: usize,
-    h: usize,
-    r: usize,
-) -> Option<(Vec<(i64, i64)>, Vec<bool>)> {
+/// A traced region: its outer ring (grid corners) and its cells.
+type Traced = (Vec<(i64, i64)>, Vec<bool>);
+
+fn trace_region(grid: Vec<bool>, w: usize, h: usize, r: usize) -> Option<Traced> {
     let closed = if r > 0 {
         let dil = dilate_disk(&grid, w, h, r as f64);
         let outside: Vec<bool> = dil.iter().map(|&b| !b).collect();
@@ -595,6 +706,42 @@ fn edt_1d(f: &[f64], out: &mut [f64], v: &mut [usize], z: &mut [f64]) {
 mod tests {
     use super::*;
     use crate::geometry::polygon::{contains, is_simple, signed_area};
+
+    #[test]
+    fn serialises_words_as_hex_and_rejects_inconsistent_grids() {
+        let mut fp = Footprint::new(0.25);
+        // Cells spread over many words, so that high bits are set.
+        let pts: Vec<DVec2> = (0..300)
+            .map(|i| DVec2::new((i % 37) as f64 * 0.25, (i / 37) as f64 * 0.5))
+            .collect();
+        fp.mark_all(&pts);
+        assert!(fp.bits.iter().any(|&w| w > 1 << 53));
+        let text = serde_json::to_string(&fp).unwrap();
+        assert!(text.contains("\"bits\":\""), "{text}");
+        let back: Footprint = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, fp);
+        // The earlier format: an array of integers.
+        let mut v = serde_json::to_value(&fp).unwrap();
+        v["bits"] = serde_json::json!(fp.bits);
+        assert_eq!(serde_json::from_value::<Footprint>(v.clone()).unwrap(), fp);
+        // Inconsistent or corrupt grids are refused.
+        for (key, bad) in [
+            ("bits", serde_json::json!("00ff")),
+            ("bits", serde_json::json!("zz".repeat(8 * fp.bits.len()))),
+            ("bits", serde_json::json!([1, 2])),
+            ("w", serde_json::json!(1u64 << 40)),
+            ("h", serde_json::json!(0)),
+            ("cell", serde_json::json!(0.0)),
+            ("x0", serde_json::json!(i64::MIN)),
+        ] {
+            let mut b = v.clone();
+            b[key] = bad.clone();
+            assert!(
+                serde_json::from_value::<Footprint>(b).is_err(),
+                "{key} = {bad}"
+            );
+        }
+    }
 
     fn grid_points(f: impl Fn(f64, f64) -> bool, step: f64, n: usize) -> Vec<DVec2> {
         let mut v = Vec::new();

@@ -170,36 +170,53 @@ pub fn remove_collinear(ring: &mut Vec<DVec2>) {
     }
 }
 
-/// Douglas–Peucker simplification of a closed ring within `tolerance` metres
-/// that never returns a non-simple ring: if the simplified ring self-intersects,
-/// the tolerance is halved until it does not (the input, if simple, is the
-/// last resort). Also enforces at most `max_vertices` by raising the tolerance.
+/// Douglas–Peucker simplification of a closed ring within `tolerance` metres,
+/// with at most `max_vertices` vertices, that never returns a non-simple
+/// ring. The tolerance is raised (x1.5 steps) until both hold; if the ring at
+/// `tolerance` has few enough vertices but self-intersects, smaller
+/// tolerances are tried first. Last resort: the ring's convex hull.
 pub fn simplify(ring: &[DVec2], tolerance: f64, max_vertices: usize) -> Vec<DVec2> {
     let n = ring.len();
-    if n <= 4 {
+    let max_vertices = max_vertices.max(4);
+    if n <= 4 || (n <= max_vertices && tolerance <= 0.0) {
         return ring.to_vec();
     }
-    let max_vertices = max_vertices.max(4);
-    let mut tol = tolerance.max(0.0);
-    // Raise the tolerance until the vertex cap is met.
-    let mut out = dp_closed(ring, tol);
-    let mut guard = 0;
-    while out.len() > max_vertices && guard < 60 {
-        tol = if tol > 0.0 { tol * 1.5 } else { 1e-3 };
-        out = dp_closed(ring, tol);
-        guard += 1;
+    let tol = tolerance.max(0.0);
+    let first = dp_closed(ring, tol);
+    if first.len() <= max_vertices && is_simple(&first) {
+        return first;
     }
-    // Lower it until the result is simple.
-    let mut guard = 0;
-    while !is_simple(&out) && guard < 40 {
-        tol *= 0.5;
-        out = dp_closed(ring, tol);
-        guard += 1;
+    if first.len() <= max_vertices {
+        let mut t = tol * 0.5;
+        for _ in 0..20 {
+            let out = dp_closed(ring, t);
+            if out.len() > max_vertices {
+                break;
+            }
+            if is_simple(&out) {
+                return out;
+            }
+            t *= 0.5;
+        }
     }
-    if is_simple(&out) {
-        out
-    } else {
-        ring.to_vec()
+    let mut t = if tol > 0.0 { tol } else { 1e-3 };
+    for _ in 0..80 {
+        t *= 1.5;
+        let out = dp_closed(ring, t);
+        if out.len() <= max_vertices && is_simple(&out) {
+            return out;
+        }
+        if out.len() < 3 {
+            break;
+        }
+    }
+    match super::hull::convex_hull(ring) {
+        Some(h) if h.len() <= max_vertices => h,
+        // Any subset of a convex polygon's vertices is convex and simple.
+        Some(h) => (0..max_vertices)
+            .map(|k| h[k * h.len() / max_vertices])
+            .collect(),
+        None => ring.to_vec(),
     }
 }
 

@@ -32,6 +32,7 @@ use glam::{DVec2, DVec3};
 
 /// Grow `prim` with the live points of `cloud`; marks taken points dead in
 /// `alive`, writes `label` into `labels` for them and returns how many.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn expand(
     prim: &mut Primitive,
     cloud: &Cloud,
@@ -62,6 +63,7 @@ pub(crate) fn expand(
     let mut cand: Vec<u32> = Vec::new();
     let mut q: Vec<DVec2> = Vec::new();
     let mut taken: Vec<bool>;
+    let mut inner: Vec<bool>;
     let mut outside: bool;
     let mut guard = 0;
     loop {
@@ -80,7 +82,7 @@ pub(crate) fn expand(
             }
         });
         // 2. Longitudinal growth.
-        (taken, outside) = grow(&prim.outline, &q, along, params);
+        (taken, inner, outside) = grow(&prim.outline, &q, along, params);
         // Does the taken region reach the edge of the gathered box?
         let mut tlo = DVec3::splat(f64::INFINITY);
         let mut thi = DVec3::splat(f64::NEG_INFINITY);
@@ -118,8 +120,11 @@ pub(crate) fn expand(
         let i = cand[k] as usize;
         alive[i] = false;
         labels[i] = prim.id;
+        // Only points inside the outline feed the plane fit: the growth ring
+        // holds the edges of crossing surfaces (the top of a car's side under
+        // its roof), which would tilt the plane a little more every scan.
         let w = cloud.origin + cloud.points[i].as_dvec3();
-        if prim.plane.signed_distance(w).abs() <= cut {
+        if inner[k] && prim.plane.signed_distance(w).abs() <= cut {
             prim.moments.push(w);
         }
         new_q.push(q[k]);
@@ -154,13 +159,21 @@ pub(crate) fn expand(
 /// it, so the clustering runs on the ring within `along` of the region and
 /// the points beyond, usually a small share of the candidates.
 ///
-/// Also returns whether any point was taken outside the outline's cells.
-fn grow(outline: &[DVec2], q: &[DVec2], along: f64, params: &Params) -> (Vec<bool>, bool) {
+/// Also returns which points lie inside the outline's cells and whether any
+/// point was taken outside them.
+fn grow(
+    outline: &[DVec2],
+    q: &[DVec2],
+    along: f64,
+    params: &Params,
+) -> (Vec<bool>, Vec<bool>, bool) {
     let mut taken = vec![false; q.len()];
+    let mut inner = vec![false; q.len()];
     let mut outside = false;
     if q.is_empty() {
-        return (taken, outside);
+        return (taken, inner, outside);
     }
+    let mut first = true;
     let cell = (along * 0.5).clamp(0.05, 1.0);
     let mut region = outline.to_vec();
     for _ in 0..32 {
@@ -176,7 +189,9 @@ fn grow(outline: &[DVec2], q: &[DVec2], along: f64, params: &Params) -> (Vec<boo
             match mask.zone(p) {
                 Zone::Inside => {
                     taken[k] = true;
+                    inner[k] = first;
                     new += 1;
+                    outside |= !first;
                 }
                 Zone::Ring => {
                     ring.push(near.len() as u32);
@@ -203,6 +218,7 @@ fn grow(outline: &[DVec2], q: &[DVec2], along: f64, params: &Params) -> (Vec<boo
                 }
             }
         }
+        first = false;
         if new == 0 || params.hull != HullKind::Convex {
             break;
         }
@@ -213,7 +229,7 @@ fn grow(outline: &[DVec2], q: &[DVec2], along: f64, params: &Params) -> (Vec<boo
             None => break,
         }
     }
-    (taken, outside)
+    (taken, inner, outside)
 }
 
 fn bounds(pts: &[DVec3]) -> (DVec3, DVec3) {

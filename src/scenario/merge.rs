@@ -23,10 +23,29 @@ fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
     if a.plane.angle_to(&b.plane) > params.merge_angle.to_radians() {
         return false;
     }
+    // The smaller one must lie on the larger one's plane: the RMS distance
+    // of its outline vertices and centroid. A centroid test alone is
+    // meaningless next to a 3000 m^2 road, where a tenth of a degree of tilt
+    // moves the plane by centimetres, and would let a sidewalk (one curb
+    // higher) merge in; a maximum would keep a slightly tilted piece apart
+    // forever.
+    let (big, small) = if a.area >= b.area { (a, b) } else { (b, a) };
+    let mut pts = small.vertices();
+    pts.push(small.moments.mean());
+    let ms = pts
+        .iter()
+        .map(|&p| {
+            let d = big.plane.signed_distance(p);
+            d * d
+        })
+        .sum::<f64>()
+        / pts.len() as f64;
+    // Or each centroid on the other's plane (two slightly tilted pieces of
+    // one surface whose far vertices disagree).
     let (ca, cb) = (a.moments.mean(), b.moments.mean());
-    if a.plane.signed_distance(cb).abs() > params.merge_distance
-        && b.plane.signed_distance(ca).abs() > params.merge_distance
-    {
+    let centroids = a.plane.signed_distance(cb).abs() <= params.merge_distance
+        && b.plane.signed_distance(ca).abs() <= params.merge_distance;
+    if ms.sqrt() > params.merge_distance && !centroids {
         return false;
     }
     let (alo, ahi) = bounds(&a.vertices());

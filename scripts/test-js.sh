@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# Tests of the JS package (assumes `scripts/setup.sh all` ran):
+#   1. build pkg/ (scripts/build-wasm.sh; quick when nothing changed) and
+#      the native CLI the Node tests compare against;
+#   2. the binding layer under Node: wasm-pack test --node (tests/wasm.rs);
+#   3. the package against pkg/node: node --test tests/js/.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+export PATH="$PWD/www/node_modules/.bin:$HOME/.cargo/bin:$PATH"
+
+scripts/build-wasm.sh
+echo "test-js: cargo build --release --bin polyscene (the native reference)"
+cargo build --release --quiet --bin polyscene
+
+echo "test-js: wasm-pack test --node (tests/wasm.rs)"
+wasm-pack --log-level warn test --node -- --test wasm 2>&1 |
+  grep -v -e "failed to get wasm-pack version" -e "no LICENSE file"
+status=${PIPESTATUS[0]}
+[ "$status" -eq 0 ] || { echo "test-js: wasm-pack test failed" >&2; exit "$status"; }
+
+echo "test-js: node --test tests/js/"
+node --test --test-reporter=spec tests/js/

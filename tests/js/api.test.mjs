@@ -1,0 +1,198 @@
+// The shape of the API: the objects it returns, the simulator, the labels,
+// the documentation of the options, the web build without a window.
+import { test } from "node:test";
+import assert from "node:assert/strict";
+import fs from "node:fs";
+import path from "node:path";
+import { Worker } from "node:worker_threads";
+import { ps, repoRoot } from "./common.mjs";
+import { optionDocs, documentedDefault, sameValue, optionsTable } from "../../scripts/gen-js-docs.mjs";
+
+const POLYGON_KEYS = ["id", "normal", "offset", "vertices", "area", "support", "density", "ground", "bornScan", "lastScan"];
+const REPORT_KEYS = ["scan", "points", "explainedByExpansion", "sentToDetection", "added", "grown", "merged", "polygonCount", "totalArea", "timeMs"];
+
+test("exports", () => {
+  for (const name of ["Scenario", "Simulation", "ScanIterator", "detect", "simulate", "defaultOptions", "version"]) {
+    assert.ok(name in ps, name);
+  }
+  assert.ok(!("start" in ps), "the start function is private");
+  assert.equal(ps.version(), JSON.parse(JSON.stringify(ps.version())));
+  assert.match(ps.version(), /^\d+\.\d+\.\d+/);
+});
+
+test("reports, polygons and labels of a street drive", () => {
+  const sim = ps.simulate({ layout: "street", seed: 1 });
+  const scenario = new ps.Scenario({ preset: "gpp2", hull: "concave", seed: 7 });
+  assert.equal(scenario.scans, 0);
+  assert.deepEqual(scenario.lastLabels(), new Uint32Array(0));
+  let report;
+  for (let k = 0; k < 3; k++) {
+    const { points, pose, stride } = sim.next();
+    report = scenario.addScan(points, { stride, pose });
+    assert.deepEqual(Object.keys(report), REPORT_KEYS);
+    assert.deepEqual(Object.keys(report.timeMs).sort(), ["detection", "expansion", "merge", "total"]);
+    assert.equal(report.scan, k);
+    assert.equal(report.points, points.length / 4);
+    assert.equal(report.explainedByExpansion + report.sentToDetection, report.points);
+    for (const m of report.merged) assert.deepEqual(Object.keys(m), ["kept", "removed"]);
+    const labels = scenario.lastLabels();
+    assert.ok(labels instanceof Uint32Array);
+    assert.equal(labels.length, report.points);
+    const ids = new Set(scenario.polygons().map((p) => p.id));
+    let explained = 0;
+    for (const l of labels) {
+      if (l !== 0xffffffff) {
+        assert.ok(ids.has(l), `label ${l} is a polygon id`);
+        explained++;
+      }
+    }
+    // Points taken by expansion keep their label; detection labels its support.
+    assert.ok(explained >= report.explainedByExpansion, `${explained} labelled, ${report.explainedByExpansion} by expansion`);
+    assert.ok(explained > 0.1 * labels.length, `${explained} of ${labels.length} points explained`);
+  }
+  assert.equal(scenario.scans, 3);
+  const polygons = scenario.polygons();
+  assert.equal(polygons.length, report.polygonCount);
+  assert.equal(scenario.polygonCount, report.polygonCount);
+  const total = polygons.reduce((a, p) => a + p.area, 0);
+  assert.ok(Math.abs(total - report.totalArea) < 1e-6 * total);
+  for (const p of polygons) {
+    assert.deepEqual(Object.keys(p), POLYGON_KEYS);
+    assert.ok(Array.isArray(p.normal) && p.normal.length === 3);
+    assert.ok(p.vertices instanceof Float64Array);
+    assert.ok(p.bornScan <= p.lastScan && p.lastScan <= 2);
+  }
+  assert.deepEqual(polygons.map((p) => p.id), [...polygons.map((p) => p.id)].sort((a, b) => a - b), "sorted by id");
+  // Results are plain JS data: JSON-safe and independent of the scenario.
+  scenario.free();
+  assert.ok(JSON.stringify(polygons).length > 100);
+  assert.ok(polygons[0].vertices.length > 0);
+  sim.free();
+});
+
+test("simulate: next(), scan(k), iteration, reset, ground truth, origin", () => {
+  const sim = ps.simulate({ layout: "street", seed: 2, step: 10 });
+  assert.equal(sim.layout, "street");
+  assert.equal(sim.seed, 2);
+  assert.ok(sim.length >= 15 && sim.length <= 30, `${sim.length} scans`);
+  assert.equal(sim.cursor, 0);
+  const first = sim.next();
+  assert.equal(first.done, false);
+  assert.equal(first.index, 0);
+  assert.equal(first.stride, 4);
+  assert.ok(first.points instanceof Float32Array && first.points.length > 400_000);
+  assert.ok(first.pose instanceof Float64Array && first.pose.length === 16);
+  assert.deepEqual([first.pose[3], first.pose[7], first.pose[11], first.pose[15]], [0, 0, 0, 1], "column-major");
+  assert.ok(Math.abs(first.pose[14] - 1.8) < 0.5, "translation in elements 12..14 (sensor height)");
+  assert.ok(first.labels instanceof Uint32Array && first.labels.length === first.points.length / 4);
+  assert.equal(sim.cursor, 1);
+  // Random access does not move the cursor and gives the same data.
+  const again = sim.scan(0);
+  assert.deepEqual(again.points, first.points);
+  assert.deepEqual(again.pose, first.pose);
+  assert.equal(sim.cursor, 1);
+  // The iterator protocol runs through the remaining scans.
+  const indices = [];
+  for (const scan of sim) indices.push(scan.index);
+  assert.deepEqual(indices, Array.from({ length: sim.length - 1 }, (_, i) => i + 1));
+  assert.deepEqual(sim.next(), { done: true });
+  assert.equal(sim.cursor, sim.length);
+  sim.reset();
+  assert.equal(sim.next().index, 0);
+  assert.equal([...sim].length, sim.length - 1);
+  const it = sim[Symbol.iterator]();
+  assert.equal(it[Symbol.iterator]().next().done, true);
+  assert.deepEqual(it.next(), { value: undefined, done: true });
+  // Ground truth.
+  const gt = sim.groundTruth();
+  assert.ok(gt.length > 100);
+  const kinds = new Set(["road", "sidewalk", "curb", "facade", "door", "wall", "vehicle", "ramp"]);
+  gt.forEach((g, i) => {
+    assert.equal(g.id, i);
+    assert.ok(kinds.has(g.kind), g.kind);
+    assert.ok(g.area > 0 && g.vertices instanceof Float64Array && g.vertices.length >= 9);
+  });
+  assert.ok(gt.some((g) => g.kind === "road"));
+  // Scene origin far away: the poses move, the sensor-frame points do not.
+  const far = ps.simulate({ layout: "street", seed: 2, step: 10, origin: [500_000, 4_500_000, 50] });
+  const s0 = far.scan(0);
+  assert.deepEqual(s0.points, first.points);
+  assert.equal(s0.pose[12], first.pose[12] + 500_000);
+  assert.equal(far.groundTruth()[0].vertices[1], gt[0].vertices[1] + 4_500_000);
+  far.free();
+  sim.free();
+});
+
+test("a Scenario far from the origin gives the same polygons, moved", () => {
+  const near = ps.simulate({ seed: 6 });
+  const far = ps.simulate({ seed: 6, origin: [500_000, 4_500_000, 50] });
+  const [a, b] = [new ps.Scenario(), new ps.Scenario()];
+  for (let k = 0; k < 3; k++) {
+    const s = near.scan(k);
+    a.addScan(s.points, { stride: 4, pose: s.pose });
+    const t = far.scan(k);
+    b.addScan(t.points, { stride: 4, pose: t.pose });
+  }
+  const [pa, pb] = [a.polygons(), b.polygons()];
+  assert.equal(pb.length, pa.length);
+  for (let i = 0; i < pa.length; i++) {
+    assert.ok(Math.abs(pa[i].area - pb[i].area) < 0.05 * pa[i].area + 0.5, `polygon ${i}`);
+  }
+  const mb = b.mesh();
+  assert.ok(Math.abs(mb.origin[0] - 500_000) < 1000 && Math.abs(mb.origin[1] - 4_500_000) < 1000);
+  assert.ok(mb.positions.every((x) => Math.abs(x) < 1000), "positions are small, relative to the origin");
+  for (const x of [a, b, near, far]) x.free();
+});
+
+test("the .d.ts documents every option, with the preset's default", () => {
+  const docs = optionDocs();
+  const gpp2 = ps.defaultOptions("gpp2");
+  const gpp1 = ps.defaultOptions("gpp1");
+  assert.deepEqual([...docs.keys()].filter((k) => k !== "preset").sort(), Object.keys(gpp2).sort(), "every key, no other");
+  const problems = [];
+  for (const [key, value] of Object.entries(gpp2)) {
+    const { doc } = docs.get(key);
+    const stated = documentedDefault(doc);
+    if (stated === undefined || !sameValue(stated, value)) {
+      problems.push(`${key}: the doc says default ${stated}, gpp2 has ${JSON.stringify(value)}`);
+    }
+    if (JSON.stringify(gpp1[key]) !== JSON.stringify(value)) {
+      const g = doc.match(/gpp1:?\s+([-+.\deE]+)/);
+      if (!g || Number(g[1]) !== gpp1[key]) {
+        problems.push(`${key}: the doc does not give gpp1's ${JSON.stringify(gpp1[key])}`);
+      }
+    }
+  }
+  assert.deepEqual(problems, [], "doc comments of Params in src/params.rs");
+});
+
+test("the README's options table is current (node scripts/gen-js-docs.mjs)", () => {
+  const readme = fs.readFileSync(path.join(repoRoot, "README.md"), "utf8");
+  assert.ok(readme.includes(optionsTable()), "regenerate it with: node scripts/gen-js-docs.mjs");
+});
+
+test("the web build (ES module, pkg/web) runs in a worker thread, without window", async () => {
+  const wasm = path.join(repoRoot, "pkg/web/polyscene_bg.wasm");
+  const url = new URL(`file://${path.join(repoRoot, "pkg/web/polyscene.js")}`).href;
+  const code = `
+    import { parentPort, workerData } from "node:worker_threads";
+    import fs from "node:fs";
+    const { default: init, Scenario, detect, simulate } = await import(workerData.url);
+    await init({ module_or_path: fs.readFileSync(workerData.wasm) });
+    if (typeof window !== "undefined") throw new Error("window exists");
+    const sim = simulate({ seed: 1 });
+    const { points, pose } = sim.next();
+    const s = new Scenario();
+    const r = s.addScan(points, { stride: 4, pose });
+    parentPort.postMessage({ count: r.polygonCount, total: r.timeMs.total, labels: s.lastLabels().length },
+      );
+  `;
+  const result = await new Promise((resolve, reject) => {
+    const w = new Worker(new URL(`data:text/javascript,${encodeURIComponent(code)}`), { workerData: { url, wasm } });
+    w.once("message", resolve);
+    w.once("error", reject);
+  });
+  assert.ok(result.count > 5, `${result.count} polygons`);
+  assert.ok(result.total > 0, "performance.now() clock installed");
+  assert.ok(result.labels > 100_000);
+});

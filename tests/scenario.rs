@@ -1,0 +1,337 @@
+//! The incremental scenario (Algorithm 2 plus merging) on simulated drives
+//! with ground truth.
+
+mod common;
+
+use glam::{DMat4, DVec3};
+use polyscene::eval::{self, EvalOptions, GtSurface};
+use polyscene::geometry::Polygon3;
+use polyscene::params::{HullKind, Params};
+use polyscene::scenario::Scenario;
+use polyscene::sim::{Drive, DriveOptions, Layout, SensorModel};
+use polyscene::Error;
+
+const SCANS: usize = 100;
+
+fn drive(layout: Layout, origin: DVec3) -> Drive {
+    Drive::new(
+        layout,
+        1,
+        SensorModel::default(),
+        DriveOptions {
+            origin,
+            ..DriveOptions::default()
+        },
+    )
+    .unwrap()
+}
+
+fn polygons(s: &Scenario) -> Vec<Polygon3> {
+    s.primitives().iter().map(|p| p.polygon()).collect()
+}
+
+struct Run {
+    scenario: Scenario,
+    explained_share_after_5: Vec<f64>,
+    duplicate_checks: usize,
+}
+
+/// Feed `SCANS` scans; check for duplicates every scan.
+fn run(d: &Drive, params: Params) -> Run {
+    let mut scenario = Scenario::new(params).unwrap();
+    let mut shares = Vec::new();
+    let mut checks = 0;
+    let opts = EvalOptions::default();
+    for k in 0..SCANS {
+        let scan = d.scan(k).unwrap();
+        let r = scenario.add_scan(&scan.points, 4, &scan.pose).unwrap();
+        assert_eq!(r.polygon_count, scenario.primitives().len());
+        assert_eq!(r.points, scan.len());
+        assert_eq!(r.explained_by_expansion + r.sent_to_detection, r.points);
+        if k >= 5 {
+            shares.push(r.explained_by_expansion as f64 / r.points as f64);
+        }
+        if scenario.params().expansion {
+            let dups = eval::duplicates(&polygons(&scenario), &opts);
+            assert_eq!(dups.count, 0, "scan {k}: duplicates {:?}", dups.pairs);
+            checks += 1;
+        }
+    }
+    Run {
+        scenario,
+        explained_share_after_5: shares,
+        duplicate_checks: checks,
+    }
+}
+
+fn ground_truth(d: &Drive) -> Vec<GtSurface> {
+    d.scene()
+        .polygons
+        .iter()
+        .map(|g| GtSurface {
+            id: g.id,
+            polygon: g.polygon.clone(),
+        })
+        .collect()
+}
+
+/// World points and labels of the first `SCANS` scans.
+fn observations(d: &Drive) -> (Vec<DVec3>, Vec<u32>) {
+    let (mut pts, mut labels) = (Vec::new(), Vec::new());
+    for k in 0..SCANS {
+        let s = d.scan(k).unwrap();
+        pts.extend(s.world_points());
+        labels.extend_from_slice(&s.labels);
+    }
+    (pts, labels)
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn drive_through(layout: Layout) {
+    let d = drive(layout, DVec3::ZERO);
+    let with = run(&d, Params::gpp2());
+    let without = run(
+        &d,
+        Params {
+            expansion: false,
+            ..Params::gpp2()
+        },
+    );
+    assert_eq!(with.duplicate_checks, SCANS);
+    // Fig. 14a: without expansion every scan re-detects and appends.
+    let (nw, nwo) = (
+        with.scenario.primitives().len(),
+        without.scenario.primitives().len(),
+    );
+    assert!(
+        nw * 5 < nwo,
+        "{layout:?}: {nw} polygons with expansion, {nwo} without"
+    );
+    // After the first scans most points are explained by expansion.
+    let share = median(with.explained_share_after_5.clone());
+    let least = with
+        .explained_share_after_5
+        .iter()
+        .copied()
+        .fold(1.0, f64::min);
+    // About a tenth of each scan is clutter (trees, poles) that no
+    // primitive can explain; measured median ~0.89 on both layouts.
+    assert!(
+        share > 0.85,
+        "{layout:?}: median share explained by expansion {share}"
+    );
+    assert!(
+        least > 0.75,
+        "{layout:?}: worst share explained by expansion {least}"
+    );
+    // As accurate and complete as one-shot detection on the accumulated cloud.
+    let gt = ground_truth(&d);
+    let (pts, labels) = observations(&d);
+    let opts = EvalOptions::default();
+    let inc = eval::evaluate(
+        &polygons(&with.scenario),
+        &gt,
+        &pts,
+        &labels,
+        pts.len(),
+        &opts,
+    )
+    .unwrap();
+    let mean_pose = d.poses()[..SCANS]
+        .iter()
+        .map(|p| p.w_axis.truncate())
+        .sum::<DVec3>()
+        / SCANS as f64;
+    let cloud = common::cloud(&pts);
+    let one = polyscene::detect::detect(
+        &cloud,
+        &Params {
+            viewpoint: mean_pose.to_array(),
+            ..Params::gpp2()
+        },
+    )
+    .unwrap();
+    let one_polys: Vec<Polygon3> = one.primitives.iter().map(|p| p.polygon()).collect();
+    let shot = eval::evaluate(&one_polys, &gt, &pts, &labels, pts.len(), &opts).unwrap();
+    eprintln!(
+        "{layout:?}: incremental P {:.3} R {:.3} H {:.4} C {:.3} n {} d {} | one-shot P {:.3} R {:.3} H {:.4} C {:.3} n {} d {} | explained median {:.3} min {:.3}",
+        inc.detection.precision,
+        inc.detection.recall,
+        inc.accuracy.mean.unwrap(),
+        inc.completeness.completeness,
+        nw,
+        inc.duplicates.count,
+        shot.detection.precision,
+        shot.detection.recall,
+        shot.accuracy.mean.unwrap(),
+        shot.completeness.completeness,
+        one_polys.len(),
+        shot.duplicates.count,
+        share,
+        least
+    );
+    // One-shot detection of the accumulated 12M points stops after the
+    // large, well-supported surfaces (recall 0.08-0.15, precision 1.0, mean
+    // error 4-10 mm, a few duplicates); the scenario finds 3-5x more of the
+    // scene, with vehicle faces (28 mm mean error) among them, so its mean
+    // error and precision are not lower than one-shot's. What it must beat:
+    assert!(inc.detection.recall > 2.0 * shot.detection.recall, "recall");
+    assert!(
+        inc.completeness.completeness > shot.completeness.completeness,
+        "completeness"
+    );
+    assert!(inc.duplicates.count <= shot.duplicates.count, "duplicates");
+    // Absolute floors, set from measurement (see BENCHMARKS.md): measured
+    // P 0.98-0.99, R 0.40-0.55, mean 9-11 mm.
+    assert!(inc.detection.precision > 0.95, "precision");
+    assert!(inc.detection.recall > 0.35, "recall");
+    assert!(inc.accuracy.mean.unwrap() < 0.015, "mean Hausdorff");
+}
+
+#[test]
+fn street_drive_with_expansion_beats_appending_and_one_shot() {
+    drive_through(Layout::Street);
+}
+
+#[test]
+fn crossing_drive_with_expansion_beats_appending_and_one_shot() {
+    drive_through(Layout::Crossing);
+}
+
+#[test]
+fn snapshot_and_restore_mid_drive_continues_identically() {
+    let d = drive(Layout::Crossing, DVec3::ZERO);
+    for hull in [HullKind::Concave, HullKind::Convex] {
+        let params = Params {
+            hull,
+            ..Params::gpp2()
+        };
+        let mut a = Scenario::new(params.clone()).unwrap();
+        let mut b = Scenario::new(params).unwrap();
+        for k in 0..12 {
+            let s = d.scan(k).unwrap();
+            a.add_scan(&s.points, 4, &s.pose).unwrap();
+            if k < 6 {
+                b.add_scan(&s.points, 4, &s.pose).unwrap();
+            }
+            if k == 5 {
+                b = Scenario::from_json(&b.to_json()).unwrap();
+            }
+            if k >= 6 {
+                b.add_scan(&s.points, 4, &s.pose).unwrap();
+            }
+        }
+        assert_eq!(a.primitives(), b.primitives(), "{hull:?}");
+        assert_eq!(a.to_json(), b.to_json());
+    }
+    assert!(Scenario::from_json("{\"not\": 1}").is_err());
+}
+
+#[test]
+fn far_from_the_origin_gives_the_same_scenario_translated() {
+    let shift = DVec3::new(500_000.0, 4_500_000.0, 50.0);
+    let (near, far) = (
+        drive(Layout::Street, DVec3::ZERO),
+        drive(Layout::Street, shift),
+    );
+    let mut a = Scenario::new(Params::gpp2()).unwrap();
+    let mut b = Scenario::new(Params::gpp2()).unwrap();
+    for k in 0..15 {
+        let (s, t) = (near.scan(k).unwrap(), far.scan(k).unwrap());
+        assert_eq!(
+            s.points, t.points,
+            "scans in the sensor frame are identical"
+        );
+        a.add_scan(&s.points, 4, &s.pose).unwrap();
+        b.add_scan(&t.points, 4, &t.pose).unwrap();
+    }
+    assert_eq!(a.primitives().len(), b.primitives().len());
+    for (p, q) in a.primitives().iter().zip(b.primitives()) {
+        assert_eq!(p.id, q.id);
+        let (u, v) = (p.vertices(), q.vertices());
+        assert_eq!(u.len(), v.len());
+        for (x, y) in u.iter().zip(&v) {
+            assert!((*x + shift - *y).length() < 1e-3, "{x} vs {y}");
+        }
+    }
+}
+
+#[test]
+fn empty_scans_and_bad_poses() {
+    let mut s = Scenario::new(Params::gpp2()).unwrap();
+    let r = s.add_scan(&[], 4, &DMat4::IDENTITY).unwrap();
+    assert_eq!((r.points, r.polygon_count, r.scan), (0, 0, 0));
+    let d = drive(Layout::Street, DVec3::ZERO);
+    let scan = d.scan(0).unwrap();
+    s.add_scan(&scan.points, 4, &scan.pose).unwrap();
+    let before = s.primitives().to_vec();
+    let r = s.add_scan(&[], 4, &scan.pose).unwrap();
+    assert_eq!(r.scan, 2);
+    assert_eq!(s.primitives(), &before[..], "an empty scan changes nothing");
+    let scaled = scan.pose * DMat4::from_scale(DVec3::splat(1.1));
+    let e = s.add_scan(&scan.points, 4, &scaled).unwrap_err();
+    assert!(matches!(e, Error::BadPose(_)), "{e}");
+    assert!(e.to_string().contains("orthonormal"));
+    let mut nan = scan.pose;
+    nan.w_axis.x = f64::NAN;
+    assert!(matches!(
+        s.add_scan(&scan.points, 4, &nan),
+        Err(Error::BadPose(_))
+    ));
+    assert!(matches!(
+        s.add_scan(&scan.points[..5], 4, &scan.pose),
+        Err(Error::BadLength { .. })
+    ));
+    assert_eq!(s.scans(), 3, "failed scans are not counted");
+    assert_eq!(s.primitives(), &before[..], "failed scans change nothing");
+}
+
+#[test]
+fn memory_is_bounded_by_the_mapped_area_not_the_scans() {
+    // The same place seen 60 times: support keeps counting (3x between scan
+    // 20 and 60) but polygons, vertices and footprint bytes barely move.
+    // (Each scan's detection draws a new random sample of the ~14k leftover
+    // clutter points and now and then accepts one more small plane there:
+    // growth bounded by the clutter of the mapped area.)
+    let d = drive(Layout::Street, DVec3::ZERO);
+    let scan = d.scan(10).unwrap();
+    let mut s = Scenario::new(Params::gpp2()).unwrap();
+    let size = |s: &Scenario| -> (usize, usize, usize) {
+        let p = s.primitives();
+        (
+            p.len(),
+            p.iter().map(|q| q.outline.len()).sum(),
+            p.iter().map(|q| q.footprint.heap_bytes()).sum(),
+        )
+    };
+    let mut sizes = Vec::new();
+    let mut support = Vec::new();
+    for _ in 0..60 {
+        s.add_scan(&scan.points, 4, &scan.pose).unwrap();
+        sizes.push(size(&s));
+        support.push(s.primitives().iter().map(|q| q.support).sum::<u64>());
+    }
+    let (early, late) = (sizes[19], sizes[59]);
+    assert!(late.0 <= early.0 + 3, "polygons {early:?} -> {late:?}");
+    assert!(
+        late.1 * 10 <= early.1 * 11,
+        "vertices {early:?} -> {late:?}"
+    );
+    assert!(
+        late.2 * 10 <= early.2 * 11,
+        "footprint bytes {early:?} -> {late:?}"
+    );
+    assert!(
+        support[59] > 2 * support[19],
+        "support should keep counting"
+    );
+    // Outlines stay within the vertex budget.
+    assert!(s
+        .primitives()
+        .iter()
+        .all(|q| q.outline.len() <= s.params().max_vertices));
+}

@@ -1,0 +1,198 @@
+//! The binding layer (`src/wasm.rs`) under Node: `wasm-pack test --node --
+//! --test wasm`. Options parsing, errors as JS `Error`s naming the problem,
+//! a small detection, the scenario's conversions. (The package as a whole is
+//! tested by `node --test tests/js/`.)
+#![cfg(target_arch = "wasm32")]
+
+use js_sys::{Array, Float32Array, Float64Array, Reflect, Uint32Array, JSON};
+use polyscene::params::Params;
+use polyscene::wasm::{default_options, detect, simulate, JsScenario};
+use wasm_bindgen::prelude::*;
+use wasm_bindgen::JsCast;
+use wasm_bindgen_test::wasm_bindgen_test;
+
+fn json(text: &str) -> JsValue {
+    JSON::parse(text).expect("test JSON")
+}
+
+fn get(v: &JsValue, key: &str) -> JsValue {
+    Reflect::get(v, &key.into()).expect("property")
+}
+
+/// The message of the `Error` a `JsError` becomes in JS.
+fn message<T>(r: Result<T, JsError>) -> String {
+    match r {
+        Ok(_) => panic!("expected an error"),
+        Err(e) => {
+            let v = JsValue::from(e);
+            let err: &js_sys::Error = v.dyn_ref().expect("a JS Error");
+            err.message().into()
+        }
+    }
+}
+
+/// A 10 m x 10 m floor sampled every 10 cm at height 0 (stride 3).
+fn floor() -> Float32Array {
+    let mut pts = Vec::new();
+    for i in 0..100 {
+        for j in 0..100 {
+            pts.extend_from_slice(&[i as f32 * 0.1, j as f32 * 0.1, 0.0]);
+        }
+    }
+    Float32Array::from(&pts[..])
+}
+
+#[wasm_bindgen_test]
+fn options_merge_over_the_preset() {
+    let s = JsScenario::new(json(
+        r#"{"preset": "gpp1", "hull": "convex", "minArea": 3, "seed": 12}"#,
+    ))
+    .unwrap();
+    let o = s.options().unwrap();
+    assert_eq!(get(&o, "hull").as_string().unwrap(), "convex");
+    assert_eq!(get(&o, "minArea").as_f64(), Some(3.0));
+    assert_eq!(get(&o, "seed").as_f64(), Some(12.0));
+    assert_eq!(
+        get(&o, "minInliers").as_f64(),
+        Some(Params::gpp1().min_inliers as f64)
+    );
+    // No options at all: gpp2.
+    let d = JsScenario::new(JsValue::UNDEFINED)
+        .unwrap()
+        .options()
+        .unwrap();
+    let want = default_options(None).unwrap();
+    assert_eq!(
+        JSON::stringify(&d).unwrap().as_string(),
+        JSON::stringify(&want).unwrap().as_string()
+    );
+    // Every Params key is in the defaults, each with a value.
+    let mut keys: Vec<String> = js_sys::Object::keys(want.unchecked_ref::<js_sys::Object>())
+        .iter()
+        .filter_map(|k| k.as_string())
+        .collect();
+    keys.sort();
+    assert_eq!(keys, Params::keys());
+}
+
+#[wasm_bindgen_test]
+fn option_errors_are_js_errors_naming_the_key() {
+    for (opts, words) in [
+        (
+            r#"{"minAreaa": 1}"#,
+            "option 'minAreaa': unknown option (did you mean 'minArea'?)",
+        ),
+        (r#"{"minArea": "big"}"#, "option 'minArea'"),
+        (r#"{"minArea": -1}"#, "option 'minArea'"),
+        (r#"{"preset": "gpp3"}"#, "option 'preset'"),
+        (r#"{"hull": "round"}"#, "option 'hull'"),
+        (r#"{"seed": 1.5}"#, "option 'seed'"),
+        (r#"{"viewpoint": [1, 2]}"#, "option 'viewpoint'"),
+    ] {
+        let m = message(JsScenario::new(json(opts)));
+        assert!(m.contains(words), "{opts}: {m}");
+    }
+    let m = message(JsScenario::new("gpp1".into()));
+    assert!(m.contains("must be an object"), "{m}");
+    // A NaN cannot come through JSON: build it by hand.
+    let o = js_sys::Object::new();
+    Reflect::set(&o, &"alpha".into(), &f64::NAN.into()).unwrap();
+    let m = message(JsScenario::new(o.into()));
+    assert!(m.contains("option 'alpha': must be a finite number"), "{m}");
+}
+
+#[wasm_bindgen_test]
+fn a_small_detection() {
+    let found = detect(floor().into(), json(r#"{"viewpoint": [5, 5, 1.8]}"#)).unwrap();
+    assert_eq!(found.length(), 1);
+    let p = found.get(0);
+    let area = get(&p, "area").as_f64().unwrap();
+    assert!((area - 99.0).abs() < 3.0, "{area}");
+    assert_eq!(get(&p, "ground").as_bool(), Some(true));
+    let normal: Array = get(&p, "normal").dyn_into().unwrap();
+    assert!(normal.get(2).as_f64().unwrap() > 0.999);
+    let v: Float64Array = get(&p, "vertices").dyn_into().unwrap();
+    assert_eq!(v.length() % 3, 0);
+    assert_eq!(get(&p, "bornScan").as_f64(), Some(0.0));
+    // Bad input: stride, length, NaN, type.
+    let m = message(detect(floor().into(), json(r#"{"stride": 5}"#)));
+    assert!(m.contains("option 'stride'"), "{m}");
+    let m = message(detect(
+        Float32Array::new_with_length(4).into(),
+        JsValue::UNDEFINED,
+    ));
+    assert!(
+        m.contains("length 4 is not a multiple of the stride 3"),
+        "{m}"
+    );
+    let nan = Float32Array::from(&[0.0, f32::NAN, 0.0][..]);
+    let m = message(detect(nan.into(), JsValue::UNDEFINED));
+    assert!(m.contains("point 0 has a NaN"), "{m}");
+    let m = message(detect("x".into(), JsValue::UNDEFINED));
+    assert!(m.contains("points must be a Float32Array"), "{m}");
+}
+
+#[wasm_bindgen_test]
+fn a_scenario_takes_scans_with_poses_and_refuses_bad_ones() {
+    let mut s = JsScenario::new(JsValue::UNDEFINED).unwrap();
+    // The floor seen from 1.8 m above its centre: the pose moves the sensor
+    // frame to the world.
+    let pose = json("[1,0,0,0, 0,1,0,0, 0,0,1,0, 5,5,1.8,1]");
+    let opts = js_sys::Object::new();
+    Reflect::set(&opts, &"pose".into(), &pose).unwrap();
+    let report = s.add_scan(floor().into(), opts.into()).unwrap();
+    assert_eq!(get(&report, "polygonCount").as_f64(), Some(1.0));
+    assert_eq!(get(&report, "points").as_f64(), Some(10_000.0));
+    let polys = s.polygons().unwrap();
+    let v: Float64Array = get(&polys.get(0), "vertices").dyn_into().unwrap();
+    // World frame: x in [5, 15] m.
+    assert!(v.to_vec().chunks(3).all(|p| p[0] > 4.5 && p[0] < 15.5));
+    let labels: Uint32Array = s.last_labels().unwrap();
+    assert_eq!(labels.length(), 10_000);
+    let mesh = s.mesh().unwrap();
+    let ids: Uint32Array = get(&mesh, "polygonIds").dyn_into().unwrap();
+    let idx: Uint32Array = get(&mesh, "indices").dyn_into().unwrap();
+    assert_eq!(idx.length(), 3 * ids.length());
+    assert!(ids.length() > 0);
+    for (pose, words) in [
+        ("[1,2,3]", "16 numbers"),
+        ("[2,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]", "not orthonormal"),
+        ("[1,0,0,5, 0,1,0,0, 0,0,1,0, 0,0,0,1]", "bottom row"),
+    ] {
+        let opts = js_sys::Object::new();
+        Reflect::set(&opts, &"pose".into(), &json(pose)).unwrap();
+        let m = message(s.add_scan(floor().into(), opts.into()));
+        assert!(
+            m.contains("invalid pose") && m.contains(words),
+            "{pose}: {m}"
+        );
+    }
+    assert_eq!(s.scans().unwrap(), 1.0, "refused scans change nothing");
+    // Snapshots: to JSON and back.
+    let snap = s.to_json().unwrap();
+    let again = JsScenario::from_json(snap).unwrap();
+    assert_eq!(again.polygon_count().unwrap(), 1);
+    let m = message(JsScenario::from_json("{}".into()));
+    assert!(m.contains("not a polyscene snapshot"), "{m}");
+    // After free(): a clear message.
+    s.release();
+    let m = message(s.polygons());
+    assert!(m.contains("Scenario was freed"), "{m}");
+}
+
+#[wasm_bindgen_test]
+fn the_simulator_runs() {
+    let sim = simulate(json(r#"{"layout": "crossing", "seed": 3, "step": 5}"#)).unwrap();
+    let n = sim.length().unwrap();
+    assert!(n > 10);
+    let scan = sim.next().unwrap();
+    assert_eq!(get(&scan, "done").as_bool(), Some(false));
+    let pts: Float32Array = get(&scan, "points").dyn_into().unwrap();
+    let labels: Uint32Array = get(&scan, "labels").dyn_into().unwrap();
+    assert_eq!(pts.length(), 4 * labels.length());
+    assert_eq!(sim.cursor().unwrap(), 1);
+    let m = message(simulate(json(r#"{"layout": "forest"}"#)));
+    assert!(m.contains("option 'layout'"), "{m}");
+    let m = message(sim.scan(n as f64));
+    assert!(m.contains("out of range"), "{m}");
+}

@@ -1,0 +1,279 @@
+// The polyscene worker: owns the wasm module, the Scenario and the scan
+// source (the built-in simulator or scans handed over by the page), and runs
+// the scans off the main thread. It speaks a small message protocol; see
+// PROTOCOL below and src/client.js, the main-thread side.
+//
+// Started as an ES module worker:
+//   new Worker(new URL('./worker.js', import.meta.url), { type: 'module' })
+//
+// PROTOCOL
+// page -> worker
+//   { type: 'configure', run, options, source? }
+//        Start run `run` from scan 0 with a new Scenario(options). `source` is
+//        { kind: 'sim', layout, seed } or
+//        { kind: 'files', label, scans: [{ name, points: Float32Array (stride 4,
+//          sensor frame), pose: 16 numbers column-major | null }] };
+//        omitted: replay the previous source. The worker keeps file scans, so
+//        a change of options replays them without the page sending them again.
+//   { type: 'play' } | { type: 'pause' } | { type: 'step' }
+//   { type: 'speed', scansPerSecond }      0 = as fast as the library goes
+//   { type: 'ack', run }                   the page consumed one 'scan' message
+//   { type: 'snapshot', request }          ask for scenario.toJSON()
+// worker -> page
+//   { type: 'ready', defaults }            wasm loaded; defaults: every option of
+//                                          each preset ({ gpp1, gpp2 }), for a GUI
+//   { type: 'reset', run, source: { kind, label, total } }
+//   { type: 'scan', run, index, total, name, points, labels, pose, report,
+//     polygons?, mesh?, workerMs }
+//        points: Float32Array stride 4, sensor frame (transferred);
+//        labels: Uint32Array, one per point (transferred);
+//        pose: Float64Array(16), column-major world-from-sensor;
+//        polygons / mesh: only when the scan changed them (their typed arrays
+//        are transferred too).
+//   { type: 'state', run, playing, done }
+//   { type: 'snapshot', request, json }     json: scenario.toJSONString() (exact)
+//   { type: 'error', run, message, fatal }  fatal: the module is unusable,
+//                                            start a new worker
+//
+// Back-pressure: at most MAX_IN_FLIGHT scans are posted and not yet acked, so
+// a slow page (software WebGL) never gets a growing queue of scans.
+
+import init, { Scenario, simulate, defaultOptions } from '../pkg/polyscene.js';
+
+const MAX_IN_FLIGHT = 2;
+const IDENTITY = new Float64Array([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]);
+
+const st = {
+  run: 0,
+  options: null,
+  source: null, // { kind: 'sim', layout, seed } | { kind: 'files', label, scans }
+  scenario: null,
+  sim: null,
+  cursor: 0,
+  total: 0,
+  playing: false,
+  interval: 100, // ms between scan starts (10 scans/s, real time for a 10 Hz sensor)
+  inFlight: 0,
+  timer: null,
+  fatal: false,
+};
+
+const ready = init()
+  .then(() => postMessage({ type: 'ready', defaults: { gpp1: defaultOptions('gpp1'), gpp2: defaultOptions('gpp2') } }))
+  .catch((e) => {
+    st.fatal = true;
+    postMessage({ type: 'error', run: 0, fatal: true, message: `cannot load the polyscene wasm module: ${msg(e)}` });
+  });
+
+function msg(e) {
+  return (e && e.message) || String(e);
+}
+
+function isTrap(e) {
+  return typeof WebAssembly !== 'undefined' && e instanceof WebAssembly.RuntimeError;
+}
+
+function fail(e, where) {
+  const fatal = isTrap(e);
+  if (fatal) st.fatal = true;
+  st.playing = false;
+  clearTimer();
+  postMessage({ type: 'error', run: st.run, fatal, message: `${where}: ${msg(e)}` });
+  postMessage({ type: 'state', run: st.run, playing: false, done: st.cursor >= st.total });
+}
+
+function clearTimer() {
+  if (st.timer !== null) clearTimeout(st.timer);
+  st.timer = null;
+}
+
+function schedule(delay) {
+  clearTimer();
+  st.timer = setTimeout(tick, delay);
+}
+
+function freeAll() {
+  try {
+    st.scenario?.free?.();
+  } catch {
+    /* already freed */
+  }
+  try {
+    st.sim?.free?.();
+  } catch {
+    /* already freed */
+  }
+  st.scenario = null;
+  st.sim = null;
+}
+
+function configure({ run, options, source }) {
+  clearTimer();
+  freeAll();
+  st.run = run;
+  st.inFlight = 0;
+  st.cursor = 0;
+  st.total = 0;
+  if (source) st.source = source;
+  if (!st.source) throw new Error('no scan source given');
+  st.options = options;
+  const src = st.source;
+  let label;
+  if (src.kind === 'sim') {
+    st.sim = simulate({ layout: src.layout, seed: src.seed });
+    st.total = st.sim.length;
+    label = src.label || `simulated HDL-64E · ${src.layout} · seed ${src.seed}`;
+  } else if (src.kind === 'files') {
+    st.total = src.scans.length;
+    label = src.label;
+  } else {
+    throw new Error(`unknown source kind '${src.kind}'`);
+  }
+  postMessage({ type: 'reset', run, source: { kind: src.kind, label, total: st.total } });
+  // Last: a bad option throws here, after the page knows the new run.
+  st.scenario = new Scenario(options);
+}
+
+/** Own, transferable copy of a typed array unless it already owns its buffer. */
+function owned(a) {
+  if (a.byteOffset === 0 && a.buffer.byteLength === a.byteLength && !(typeof SharedArrayBuffer !== 'undefined' && a.buffer instanceof SharedArrayBuffer)) return a;
+  return a.slice();
+}
+
+function stepOnce() {
+  if (!st.scenario || st.cursor >= st.total) return false;
+  const t0 = performance.now();
+  const index = st.cursor++;
+  let points, pose, name;
+  if (st.sim) {
+    const s = st.sim.next();
+    points = s.points;
+    pose = s.pose;
+    name = `scan ${index}`;
+  } else {
+    const f = st.source.scans[index];
+    points = f.points;
+    pose = f.pose ? Float64Array.from(f.pose) : IDENTITY.slice();
+    name = f.name;
+  }
+  const report = st.scenario.addScan(points, { stride: 4, pose });
+  const labels = owned(st.scenario.lastLabels());
+  const changed =
+    index === 0 || report.added.length > 0 || report.grown.length > 0 || report.merged.length > 0;
+  const transfer = [];
+  let polygons, mesh;
+  if (changed) {
+    polygons = st.scenario.polygons();
+    for (const p of polygons) {
+      p.vertices = owned(p.vertices);
+      transfer.push(p.vertices.buffer);
+    }
+    mesh = st.scenario.mesh();
+    mesh.positions = owned(mesh.positions);
+    mesh.indices = owned(mesh.indices);
+    mesh.polygonIds = owned(mesh.polygonIds);
+    transfer.push(mesh.positions.buffer, mesh.indices.buffer, mesh.polygonIds.buffer);
+  }
+  // Simulated scans are ours to give away; file scans stay here for replays.
+  const shown = st.sim ? owned(points) : points.slice();
+  transfer.push(shown.buffer, labels.buffer);
+  const poseOut = Float64Array.from(pose);
+  st.inFlight++;
+  postMessage(
+    {
+      type: 'scan',
+      run: st.run,
+      index,
+      total: st.total,
+      name,
+      points: shown,
+      labels,
+      pose: poseOut,
+      report,
+      polygons,
+      mesh,
+      workerMs: performance.now() - t0,
+    },
+    transfer,
+  );
+  if (st.cursor >= st.total) {
+    st.playing = false;
+    postMessage({ type: 'state', run: st.run, playing: false, done: true });
+  }
+  return true;
+}
+
+function tick() {
+  st.timer = null;
+  if (!st.playing || st.fatal) return;
+  if (st.inFlight >= MAX_IN_FLIGHT) return; // resumed by the next ack
+  const t0 = performance.now();
+  try {
+    if (!stepOnce()) {
+      st.playing = false;
+      postMessage({ type: 'state', run: st.run, playing: false, done: true });
+      return;
+    }
+  } catch (e) {
+    fail(e, `scan ${st.cursor - 1}`);
+    return;
+  }
+  if (st.playing) schedule(Math.max(0, st.interval - (performance.now() - t0)));
+}
+
+onmessage = async (ev) => {
+  await ready;
+  const m = ev.data;
+  if (st.fatal && m.type !== 'snapshot') {
+    postMessage({ type: 'error', run: m.run ?? st.run, fatal: true, message: 'the polyscene module stopped working; restarting it' });
+    return;
+  }
+  try {
+    switch (m.type) {
+      case 'configure': {
+        const wasPlaying = m.play ?? st.playing;
+        st.playing = false;
+        configure(m);
+        st.playing = wasPlaying;
+        postMessage({ type: 'state', run: st.run, playing: st.playing, done: false });
+        if (st.playing) schedule(0);
+        break;
+      }
+      case 'play':
+        if (st.cursor >= st.total) break;
+        st.playing = true;
+        postMessage({ type: 'state', run: st.run, playing: true, done: false });
+        if (st.timer === null) schedule(0);
+        break;
+      case 'pause':
+        st.playing = false;
+        clearTimer();
+        postMessage({ type: 'state', run: st.run, playing: false, done: st.cursor >= st.total });
+        break;
+      case 'step':
+        st.playing = false;
+        clearTimer();
+        postMessage({ type: 'state', run: st.run, playing: false, done: st.cursor >= st.total });
+        stepOnce();
+        break;
+      case 'speed': {
+        const v = Number(m.scansPerSecond);
+        st.interval = v > 0 ? 1000 / v : 0;
+        if (st.playing) schedule(0);
+        break;
+      }
+      case 'ack':
+        if (m.run !== st.run) break;
+        st.inFlight = Math.max(0, st.inFlight - 1);
+        if (st.playing && st.timer === null) schedule(0);
+        break;
+      case 'snapshot':
+        postMessage({ type: 'snapshot', request: m.request, json: st.scenario ? st.scenario.toJSONString() : null });
+        break;
+      default:
+        throw new Error(`unknown message type '${m.type}'`);
+    }
+  } catch (e) {
+    fail(e, m.type === 'configure' ? 'options' : m.type);
+  }
+};
