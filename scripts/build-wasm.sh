@@ -19,8 +19,16 @@ for tool in wasm-pack wasm-bindgen wasm-opt; do
   fi
 done
 
+# One build at a time (make test, make demo and people may run this at once).
+mkdir -p pkg
+exec 9>pkg/.build.lock
+if ! flock -n 9; then
+  echo "build-wasm: waiting for another build-wasm.sh to finish"
+  flock 9
+fi
+
 inputs_hash() {
-  find src Cargo.toml Cargo.lock scripts/build-wasm.sh -type f -print0 | sort -z |
+  find src build.rs Cargo.toml Cargo.lock .cargo scripts/build-wasm.sh -type f -print0 | sort -z |
     xargs -0 sha256sum | sha256sum | cut -d' ' -f1
 }
 

@@ -210,7 +210,7 @@ impl Params {
             min_density: 48.0,
             min_occupancy: 0.5,
             max_primitives: 200,
-            max_rejections: 24,
+            max_rejections: 10,
             max_work: 2_000_000_000,
             expansion: true,
             ground_expand_across: 0.08,
@@ -248,10 +248,16 @@ impl Params {
     /// The option keys, camelCase as in JSON and the JS options (`preset`
     /// not included), sorted.
     pub fn keys() -> Vec<String> {
-        match serde_json::to_value(Params::gpp2()) {
-            Ok(serde_json::Value::Object(map)) => map.keys().cloned().collect(),
-            _ => Vec::new(),
-        }
+        Params::gpp2().as_map().keys().cloned().collect()
+    }
+
+    /// The parameters as a JSON object. (Through the JSON text: the same
+    /// serde code as snapshots, which keeps the wasm build small.)
+    fn as_map(&self) -> serde_json::Map<String, serde_json::Value> {
+        serde_json::to_string(self)
+            .ok()
+            .and_then(|text| serde_json::from_str(&text).ok())
+            .unwrap_or_default()
     }
 
     /// Parameters from an options object (the JS options): start from the
@@ -281,9 +287,7 @@ impl Params {
                 })
             }
         };
-        let Ok(Value::Object(mut merged)) = serde_json::to_value(&base) else {
-            return Err(Error::Invalid("parameters do not serialise".into()));
-        };
+        let mut merged = base.as_map();
         for (key, value) in options {
             if key == "preset" {
                 continue;
@@ -303,8 +307,8 @@ impl Params {
             }
             // Check this key alone (missing keys take defaults), so that a
             // type error is attributed to it.
-            let single = serde_json::Map::from_iter([(key.clone(), value.clone())]);
-            if let Err(e) = serde_json::from_value::<Params>(Value::Object(single)) {
+            let single = Value::Object(serde_json::Map::from_iter([(key.clone(), value.clone())]));
+            if let Err(e) = serde_json::from_str::<Params>(&single.to_string()) {
                 return Err(Error::BadOption {
                     key: key.clone(),
                     reason: plain_serde_message(&e.to_string()),
@@ -312,7 +316,7 @@ impl Params {
             }
             merged.insert(key.clone(), value.clone());
         }
-        let params: Params = serde_json::from_value(Value::Object(merged))
+        let params: Params = serde_json::from_str(&Value::Object(merged).to_string())
             .map_err(|e| Error::Invalid(format!("options: {e}")))?;
         params.validate()?;
         Ok(params)
@@ -480,6 +484,7 @@ fn closest_key<'a>(key: &str, keys: &'a [String]) -> Option<&'a str> {
 
 /// A serde type error in the words of the options' documentation.
 fn plain_serde_message(msg: &str) -> String {
+    let msg = msg.split(" at line ").next().unwrap_or(msg);
     msg.replace("expected f64", "expected a number")
         .replace("expected u64", "expected a non-negative integer")
         .replace("expected usize", "expected a non-negative integer")

@@ -478,10 +478,11 @@ fn polygons_array(prims: &[Primitive]) -> Array {
     prims.iter().map(polygon_object).collect()
 }
 
+/// A serialisable value as a plain JS object, through JSON text (the serde
+/// code is shared with snapshots, which keeps the wasm small).
 fn to_js<T: serde::Serialize>(value: &T) -> JsResult<JsValue> {
-    value
-        .serialize(&serde_wasm_bindgen::Serializer::json_compatible())
-        .map_err(|e| invalid(e.to_string()))
+    let text = serde_json::to_string(value).map_err(|e| invalid(e.to_string()))?;
+    js_sys::JSON::parse(&text).map_err(|_| invalid("internal error: unparsable JSON"))
 }
 
 fn scan_object(index: usize, scan: &Scan) -> Object {
@@ -515,8 +516,9 @@ fn scan_object(index: usize, scan: &Scan) -> Object {
 #[wasm_bindgen(unchecked_return_type = "Polygon[]")]
 pub fn detect(
     #[wasm_bindgen(unchecked_param_type = "Float32Array")] points: JsValue,
-    #[wasm_bindgen(unchecked_param_type = "DetectOptions")] options: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "DetectOptions")] options: Option<JsValue>,
 ) -> JsResult<Array> {
+    let options = options.unwrap_or(JsValue::UNDEFINED);
     let mut map = options_map("detect options", &options).map_err(js_err)?;
     let stride = take_stride(&mut map, 3).map_err(js_err)?;
     let params = Params::from_options(&map).map_err(js_err)?;
@@ -578,8 +580,9 @@ impl JsScenario {
     /// Throws on an unknown key or a bad value, naming the key.
     #[wasm_bindgen(constructor)]
     pub fn new(
-        #[wasm_bindgen(unchecked_param_type = "ScenarioOptions")] options: JsValue,
+        #[wasm_bindgen(unchecked_param_type = "ScenarioOptions")] options: Option<JsValue>,
     ) -> JsResult<JsScenario> {
+        let options = options.unwrap_or(JsValue::UNDEFINED);
         let map = options_map("Scenario options", &options).map_err(js_err)?;
         let params = Params::from_options(&map).map_err(js_err)?;
         let inner = Scenario::new(params).map_err(js_err)?;
@@ -601,9 +604,10 @@ impl JsScenario {
     pub fn add_scan(
         &mut self,
         #[wasm_bindgen(unchecked_param_type = "Float32Array")] points: JsValue,
-        #[wasm_bindgen(unchecked_param_type = "ScanOptions")] options: JsValue,
+        #[wasm_bindgen(unchecked_param_type = "ScanOptions")] options: Option<JsValue>,
     ) -> JsResult<JsValue> {
         let scenario = self.get_mut()?;
+        let options = options.unwrap_or(JsValue::UNDEFINED);
         let mut pose = DMat4::IDENTITY;
         let mut stride = 3;
         for (key, value) in option_entries("addScan options", &options).map_err(js_err)? {
@@ -786,8 +790,9 @@ impl JsSimulation {
 /// or a bad value, naming the key.
 #[wasm_bindgen]
 pub fn simulate(
-    #[wasm_bindgen(unchecked_param_type = "SimulateOptions")] options: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "SimulateOptions")] options: Option<JsValue>,
 ) -> JsResult<JsSimulation> {
+    let options = options.unwrap_or(JsValue::UNDEFINED);
     let mut map = options_map("simulate options", &options).map_err(js_err)?;
     let layout: Layout = match map.remove("layout") {
         None => Layout::Street,
@@ -815,7 +820,7 @@ pub fn simulate(
             .ok_or_else(|| js_err(bad_option("step", format!("expected a number, got {v}"))))?;
     }
     if let Some(v) = map.remove("origin") {
-        let o: Option<[f64; 3]> = serde_json::from_value(v.clone()).ok();
+        let o: Option<[f64; 3]> = serde_json::from_str(&v.to_string()).ok();
         drive_options.origin = DVec3::from_array(o.ok_or_else(|| {
             js_err(bad_option(
                 "origin",

@@ -44,9 +44,9 @@ fn floor() -> Float32Array {
 
 #[wasm_bindgen_test]
 fn options_merge_over_the_preset() {
-    let s = JsScenario::new(json(
+    let s = JsScenario::new(Some(json(
         r#"{"preset": "gpp1", "hull": "convex", "minArea": 3, "seed": 12}"#,
-    ))
+    )))
     .unwrap();
     let o = s.options().unwrap();
     assert_eq!(get(&o, "hull").as_string().unwrap(), "convex");
@@ -57,10 +57,7 @@ fn options_merge_over_the_preset() {
         Some(Params::gpp1().min_inliers as f64)
     );
     // No options at all: gpp2.
-    let d = JsScenario::new(JsValue::UNDEFINED)
-        .unwrap()
-        .options()
-        .unwrap();
+    let d = JsScenario::new(None).unwrap().options().unwrap();
     let want = default_options(None).unwrap();
     assert_eq!(
         JSON::stringify(&d).unwrap().as_string(),
@@ -89,21 +86,21 @@ fn option_errors_are_js_errors_naming_the_key() {
         (r#"{"seed": 1.5}"#, "option 'seed'"),
         (r#"{"viewpoint": [1, 2]}"#, "option 'viewpoint'"),
     ] {
-        let m = message(JsScenario::new(json(opts)));
+        let m = message(JsScenario::new(Some(json(opts))));
         assert!(m.contains(words), "{opts}: {m}");
     }
-    let m = message(JsScenario::new("gpp1".into()));
+    let m = message(JsScenario::new(Some("gpp1".into())));
     assert!(m.contains("must be an object"), "{m}");
     // A NaN cannot come through JSON: build it by hand.
     let o = js_sys::Object::new();
     Reflect::set(&o, &"alpha".into(), &f64::NAN.into()).unwrap();
-    let m = message(JsScenario::new(o.into()));
+    let m = message(JsScenario::new(Some(o.into())));
     assert!(m.contains("option 'alpha': must be a finite number"), "{m}");
 }
 
 #[wasm_bindgen_test]
 fn a_small_detection() {
-    let found = detect(floor().into(), json(r#"{"viewpoint": [5, 5, 1.8]}"#)).unwrap();
+    let found = detect(floor().into(), Some(json(r#"{"viewpoint": [5, 5, 1.8]}"#))).unwrap();
     assert_eq!(found.length(), 1);
     let p = found.get(0);
     let area = get(&p, "area").as_f64().unwrap();
@@ -115,32 +112,29 @@ fn a_small_detection() {
     assert_eq!(v.length() % 3, 0);
     assert_eq!(get(&p, "bornScan").as_f64(), Some(0.0));
     // Bad input: stride, length, NaN, type.
-    let m = message(detect(floor().into(), json(r#"{"stride": 5}"#)));
+    let m = message(detect(floor().into(), Some(json(r#"{"stride": 5}"#))));
     assert!(m.contains("option 'stride'"), "{m}");
-    let m = message(detect(
-        Float32Array::new_with_length(4).into(),
-        JsValue::UNDEFINED,
-    ));
+    let m = message(detect(Float32Array::new_with_length(4).into(), None));
     assert!(
         m.contains("length 4 is not a multiple of the stride 3"),
         "{m}"
     );
     let nan = Float32Array::from(&[0.0, f32::NAN, 0.0][..]);
-    let m = message(detect(nan.into(), JsValue::UNDEFINED));
+    let m = message(detect(nan.into(), None));
     assert!(m.contains("point 0 has a NaN"), "{m}");
-    let m = message(detect("x".into(), JsValue::UNDEFINED));
+    let m = message(detect("x".into(), None));
     assert!(m.contains("points must be a Float32Array"), "{m}");
 }
 
 #[wasm_bindgen_test]
 fn a_scenario_takes_scans_with_poses_and_refuses_bad_ones() {
-    let mut s = JsScenario::new(JsValue::UNDEFINED).unwrap();
+    let mut s = JsScenario::new(None).unwrap();
     // The floor seen from 1.8 m above its centre: the pose moves the sensor
     // frame to the world.
     let pose = json("[1,0,0,0, 0,1,0,0, 0,0,1,0, 5,5,1.8,1]");
     let opts = js_sys::Object::new();
     Reflect::set(&opts, &"pose".into(), &pose).unwrap();
-    let report = s.add_scan(floor().into(), opts.into()).unwrap();
+    let report = s.add_scan(floor().into(), Some(opts.into())).unwrap();
     assert_eq!(get(&report, "polygonCount").as_f64(), Some(1.0));
     assert_eq!(get(&report, "points").as_f64(), Some(10_000.0));
     let polys = s.polygons().unwrap();
@@ -161,7 +155,7 @@ fn a_scenario_takes_scans_with_poses_and_refuses_bad_ones() {
     ] {
         let opts = js_sys::Object::new();
         Reflect::set(&opts, &"pose".into(), &json(pose)).unwrap();
-        let m = message(s.add_scan(floor().into(), opts.into()));
+        let m = message(s.add_scan(floor().into(), Some(opts.into())));
         assert!(
             m.contains("invalid pose") && m.contains(words),
             "{pose}: {m}"
@@ -182,7 +176,10 @@ fn a_scenario_takes_scans_with_poses_and_refuses_bad_ones() {
 
 #[wasm_bindgen_test]
 fn the_simulator_runs() {
-    let sim = simulate(json(r#"{"layout": "crossing", "seed": 3, "step": 5}"#)).unwrap();
+    let sim = simulate(Some(json(
+        r#"{"layout": "crossing", "seed": 3, "step": 5}"#,
+    )))
+    .unwrap();
     let n = sim.length().unwrap();
     assert!(n > 10);
     let scan = sim.next().unwrap();
@@ -191,7 +188,7 @@ fn the_simulator_runs() {
     let labels: Uint32Array = get(&scan, "labels").dyn_into().unwrap();
     assert_eq!(pts.length(), 4 * labels.length());
     assert_eq!(sim.cursor().unwrap(), 1);
-    let m = message(simulate(json(r#"{"layout": "forest"}"#)));
+    let m = message(simulate(Some(json(r#"{"layout": "forest"}"#))));
     assert!(m.contains("option 'layout'"), "{m}");
     let m = message(sim.scan(n as f64));
     assert!(m.contains("out of range"), "{m}");

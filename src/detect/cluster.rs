@@ -7,7 +7,7 @@
 //! than `tol`; only cells whose boxes are closer than `tol` are compared (a
 //! 5x5 neighbourhood), and the comparison stops at the first close pair.
 
-use crate::hash::{key2, GridMap};
+use crate::hash::{floor_i64, key2, GridMap};
 use glam::DVec2;
 
 /// Indices of the points in the largest cluster (ties: the cluster holding
@@ -41,16 +41,23 @@ pub fn clusters(points: &[DVec2], tol: f64) -> (Vec<u32>, Vec<u32>) {
         1e-9
     };
     let side = tol / std::f64::consts::SQRT_2;
-    // Cell ids in first-seen order.
-    let mut map: GridMap<u64, u32> = GridMap::default();
+    // Cell ids in first-seen order; looked up in a dense array when the
+    // bounding box is small enough (the usual case), else in a hash map.
+    let cell_of_point = |p: &DVec2| (floor_i64(p.x / side), floor_i64(p.y / side));
+    let (mut lo, mut hi) = ((i64::MAX, i64::MAX), (i64::MIN, i64::MIN));
+    for p in points {
+        let (x, y) = cell_of_point(p);
+        lo = (lo.0.min(x), lo.1.min(y));
+        hi = (hi.0.max(x), hi.1.max(y));
+    }
+    let (gw, gh) = ((hi.0 - lo.0 + 1) as u128, (hi.1 - lo.1 + 1) as u128);
+    let dense = gw * gh <= 4 * n as u128 + 65_536;
+    let mut lookup = CellLookup::new(dense, lo, (gw as usize, gh as usize));
     let mut cell_key: Vec<(i64, i64)> = Vec::new();
     let mut cell_of = Vec::with_capacity(n);
     for p in points {
-        let (cx, cy) = (
-            crate::hash::floor_i64(p.x / side),
-            crate::hash::floor_i64(p.y / side),
-        );
-        let id = *map.entry(key2(cx, cy)).or_insert_with(|| {
+        let (cx, cy) = cell_of_point(p);
+        let id = lookup.get_or_insert(cx, cy, || {
             cell_key.push((cx, cy));
             (cell_key.len() - 1) as u32
         });
@@ -91,7 +98,7 @@ pub fn clusters(points: &[DVec2], tol: f64) -> (Vec<u32>, Vec<u32>) {
         let (cx, cy) = cell_key[c];
         let a = &items[start[c] as usize..start[c + 1] as usize];
         for &(dx, dy) in &offsets {
-            let Some(&nb) = map.get(&key2(cx + dx, cy + dy)) else {
+            let Some(nb) = lookup.get(cx + dx, cy + dy) else {
                 continue;
             };
             let (ra, rb) = (find(&mut parent, c as u32), find(&mut parent, nb));
@@ -128,6 +135,59 @@ fn find(parent: &mut [u32], mut x: u32) -> u32 {
         x = gp;
     }
     x
+}
+
+/// Cell id lookup: a dense array over the cells' bounding box, or a hash map.
+enum CellLookup {
+    Dense {
+        lo: (i64, i64),
+        w: usize,
+        h: usize,
+        ids: Vec<u32>,
+    },
+    Sparse(GridMap<u64, u32>),
+}
+
+impl CellLookup {
+    fn new(dense: bool, lo: (i64, i64), (w, h): (usize, usize)) -> Self {
+        if dense {
+            CellLookup::Dense {
+                lo,
+                w,
+                h,
+                ids: vec![u32::MAX; w * h],
+            }
+        } else {
+            CellLookup::Sparse(GridMap::default())
+        }
+    }
+
+    fn get(&self, x: i64, y: i64) -> Option<u32> {
+        match self {
+            CellLookup::Dense { lo, w, h, ids } => {
+                let (dx, dy) = (x - lo.0, y - lo.1);
+                if dx < 0 || dy < 0 || dx as usize >= *w || dy as usize >= *h {
+                    return None;
+                }
+                let id = ids[dy as usize * w + dx as usize];
+                (id != u32::MAX).then_some(id)
+            }
+            CellLookup::Sparse(map) => map.get(&key2(x, y)).copied(),
+        }
+    }
+
+    fn get_or_insert(&mut self, x: i64, y: i64, new: impl FnOnce() -> u32) -> u32 {
+        match self {
+            CellLookup::Dense { lo, w, ids, .. } => {
+                let k = (y - lo.1) as usize * *w + (x - lo.0) as usize;
+                if ids[k] == u32::MAX {
+                    ids[k] = new();
+                }
+                ids[k]
+            }
+            CellLookup::Sparse(map) => *map.entry(key2(x, y)).or_insert_with(new),
+        }
+    }
 }
 
 #[cfg(test)]

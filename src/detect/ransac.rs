@@ -21,13 +21,14 @@
 //!   needed for `confidence` is recomputed from the best inlier ratio (with
 //!   an assumed chance of 1/2 that a local triple started on a plane stays on it), bounded by
 //!   `[24, max_hypotheses]`.
-//! - **Confirmation and local optimisation.** The best hypothesis is
-//!   counted on all remaining points, refit by least squares (f64 PCA) on
-//!   its inliers, and counted again.
+//! - **Local optimisation and confirmation.** The best hypothesis is refit
+//!   by robust least squares (f64 PCA, trimmed) on its inliers among a
+//!   random subsample of at most 65 536 points, and the refined plane is
+//!   counted once on all remaining points.
 //!
 //! Bounds on work per primitive: at most `max_hypotheses * k` distance
 //! evaluations per prefix size (and at most `4 * max_hypotheses` samples), prefix sizes grow geometrically to `n`, plus
-//! three full passes over the `n` remaining points. Every evaluation is
+//! one full pass over the `n` remaining points. Every evaluation is
 //! counted in `work` so the cascade can enforce `Params::max_work`.
 
 use crate::geometry::Moments;
@@ -60,6 +61,10 @@ pub struct PlanePool<'a> {
     cell_start: Vec<u32>,
     cell_items: Vec<u32>,
     rng: Rng,
+    /// Points still in play (the arrays may also hold dead ones, as NaN).
+    live: usize,
+    /// Pool position of each original index (`u32::MAX` once compacted away).
+    pos_of: Vec<u32>,
     /// Point-to-plane distance evaluations so far.
     pub work: u64,
 }
@@ -67,6 +72,8 @@ pub struct PlanePool<'a> {
 const START_K: usize = 4096;
 const MIN_RANKABLE: usize = 40;
 const MIN_HYPOTHESES: usize = 24;
+/// Most points the local optimisation (robust refit) looks at.
+const LO_SAMPLE: usize = 65_536;
 
 impl<'a> PlanePool<'a> {
     /// All of `pts` in play, shuffled once with `rng`.
@@ -107,7 +114,13 @@ impl<'a> PlanePool<'a> {
             cell_items[fill[c as usize] as usize] = i as u32;
             fill[c as usize] += 1;
         }
+        let mut pos_of = vec![0u32; n];
+        for (pos, &i) in order.iter().enumerate() {
+            pos_of[i as usize] = pos as u32;
+        }
         PlanePool {
+            live: n,
+            pos_of,
             pts,
             alive: vec![true; n],
             rx,
@@ -124,18 +137,27 @@ impl<'a> PlanePool<'a> {
 
     /// Number of points still in play.
     pub fn remaining(&self) -> usize {
-        self.ridx.len()
+        self.live
     }
 
-    /// Original indices of the points still in play, in pool order.
-    pub fn remaining_indices(&self) -> &[u32] {
-        &self.ridx
-    }
-
-    /// Take these original indices out of play.
+    /// Take these original indices out of play. Their coordinates in the
+    /// pool become NaN, which fails every inlier test, so no pass over the
+    /// pool needs to check liveness; the arrays are compacted only once half
+    /// of them is dead (which keeps the order, so prefixes stay random).
     pub fn remove(&mut self, originals: &[u32]) {
         for &i in originals {
+            if !self.alive[i as usize] {
+                continue;
+            }
             self.alive[i as usize] = false;
+            self.live -= 1;
+            let pos = self.pos_of[i as usize] as usize;
+            self.rx[pos] = f32::NAN;
+            self.ry[pos] = f32::NAN;
+            self.rz[pos] = f32::NAN;
+        }
+        if 2 * self.live >= self.ridx.len() {
+            return;
         }
         let mut w = 0;
         for r in 0..self.ridx.len() {
@@ -145,6 +167,7 @@ impl<'a> PlanePool<'a> {
                 self.rx[w] = self.rx[r];
                 self.ry[w] = self.ry[r];
                 self.rz[w] = self.rz[r];
+                self.pos_of[i as usize] = w as u32;
                 w += 1;
             }
         }
@@ -164,10 +187,11 @@ impl<'a> PlanePool<'a> {
         params: &Params,
         viewpoint: DVec3,
     ) -> Option<(LocalPlane, Vec<u32>)> {
-        let n = self.remaining();
-        if n < params.min_inliers.max(3) {
+        if self.remaining() < params.min_inliers.max(3) {
             return None;
         }
+        // Prefixes run over the pool arrays, dead (NaN) entries included.
+        let n = self.ridx.len();
         let tilt_cos = libm::cos(params.ground_max_tilt.to_radians());
         let threshold_for = |normal: DVec3, offset: f64| {
             let depth = (normal.dot(viewpoint) + offset) * normal.z.signum();
@@ -212,24 +236,27 @@ impl<'a> PlanePool<'a> {
             }
             break best.0;
         };
-        // Confirm on all points, refit, count again.
+        // Local optimisation on a random subsample (a prefix of the shuffled
+        // pool: at most LO_SAMPLE points), then one count on all points with
+        // the refined plane.
+        let lo_k = n.min(LO_SAMPLE);
+        let sample = self.collect_prefix(&best, lo_k);
         let mut plane = best;
-        let mut inliers = self.collect(&plane);
-        if inliers.len() >= 3 {
-            if let Some(refit) = self.refit(&inliers) {
+        if sample.len() >= 3 {
+            if let Some(refit) = self.refit(&sample) {
                 let refit = LocalPlane {
                     threshold: threshold_for(refit.normal, refit.offset),
                     ..refit
                 };
-                let again = self.collect(&refit);
                 // The least-squares plane beats a three-point plane; keep it
                 // unless it explains clearly fewer points.
-                if 10 * again.len() >= 9 * inliers.len() {
+                let again = self.collect_prefix(&refit, lo_k);
+                if 10 * again.len() >= 9 * sample.len() {
                     plane = refit;
-                    inliers = again;
                 }
             }
         }
+        let inliers = self.collect(&plane);
         if inliers.len() < params.min_inliers.max(3) {
             return None;
         }
@@ -238,22 +265,25 @@ impl<'a> PlanePool<'a> {
     }
 
     /// Do at least 30 % of the live points of voxel `cell` lie on `plane`?
+    /// Judged on at most 64 of its members (an even stride): near the sensor
+    /// a voxel holds thousands of points, and an estimate is all this needs.
     fn locally_planar(&mut self, plane: &LocalPlane, cell: usize) -> bool {
         let members =
             &self.cell_items[self.cell_start[cell] as usize..self.cell_start[cell + 1] as usize];
+        let step = members.len().div_ceil(64).max(1);
         let (n, d, t) = (
             plane.normal.as_vec3(),
             plane.offset as f32,
             plane.threshold as f32,
         );
         let (mut live, mut on) = (0u32, 0u32);
-        for &j in members {
+        for &j in members.iter().step_by(step) {
             if self.alive[j as usize] {
                 live += 1;
                 on += ((n.dot(self.pts[j as usize]) + d).abs() < t) as u32;
             }
         }
-        self.work += members.len() as u64;
+        self.work += (members.len() / step) as u64;
         10 * on >= 3 * live
     }
 
@@ -261,7 +291,16 @@ impl<'a> PlanePool<'a> {
     /// `None` when degenerate.
     fn sample(&mut self) -> Option<(DVec3, f64, usize)> {
         let n = self.ridx.len();
-        let i1 = self.ridx[self.rng.below(n)];
+        let mut i1 = self.ridx[self.rng.below(n)];
+        for _ in 0..8 {
+            if self.alive[i1 as usize] {
+                break;
+            }
+            i1 = self.ridx[self.rng.below(n)];
+        }
+        if !self.alive[i1 as usize] {
+            return None;
+        }
         let c = self.cell_of[i1 as usize] as usize;
         let members =
             &self.cell_items[self.cell_start[c] as usize..self.cell_start[c + 1] as usize];
@@ -272,7 +311,12 @@ impl<'a> PlanePool<'a> {
                     return j;
                 }
             }
-            self.ridx[rng.below(n)]
+            let j = self.ridx[rng.below(n)];
+            if self.alive[j as usize] {
+                j
+            } else {
+                i1
+            }
         };
         let i2 = pick(&mut self.rng, &[i1]);
         let i3 = pick(&mut self.rng, &[i1, i2]);
@@ -326,6 +370,23 @@ impl<'a> PlanePool<'a> {
         }
         self.work += k as u64;
         c1 + self.count(plane, head, k)
+    }
+
+    /// Pool positions of the inliers of `plane` among the first `k` points.
+    fn collect_prefix(&mut self, plane: &LocalPlane, k: usize) -> Vec<u32> {
+        let (nx, ny, nz) = (
+            plane.normal.x as f32,
+            plane.normal.y as f32,
+            plane.normal.z as f32,
+        );
+        let (d, t) = (plane.offset as f32, plane.threshold as f32);
+        self.work += k as u64;
+        (0..k as u32)
+            .filter(|&i| {
+                let i = i as usize;
+                (nx * self.rx[i] + ny * self.ry[i] + nz * self.rz[i] + d).abs() < t
+            })
+            .collect()
     }
 
     /// Pool positions of all inliers of `plane`.

@@ -23,6 +23,13 @@ use serde::{Deserialize, Serialize};
 /// traced at a coarser resolution (cells merged 2x2 until it fits).
 pub const MAX_TRACE_CELLS: usize = 4_000_000;
 
+/// Most cells a footprint grid holds (2^30, 128 MiB of bits; about 6.5 km a
+/// side at 0.2 m cells), and the farthest its corner may lie from the frame
+/// origin (2^40 cells). Points beyond are not recorded: memory stays bounded
+/// (and the index arithmetic within `usize` on wasm32) whatever the input.
+pub const MAX_CELLS: u64 = 1 << 30;
+const MAX_OFFSET: i128 = 1 << 40;
+
 /// A growable occupancy bit grid in a plane's 2D frame.
 ///
 /// Serialised as `{cell, x0, y0, w, h, bits}` with `bits` a hex string (16
@@ -61,16 +68,15 @@ impl TryFrom<FootprintData> for Footprint {
         // side, 2^40 cells from the frame origin) would overflow later.
         const SIDE: usize = 1 << 31;
         const OFFSET: u64 = 1 << 40;
-        let cells = d.w.checked_mul(d.h).unwrap_or(usize::MAX);
+        let cells = d.w.checked_mul(d.h);
         let ok = d.cell.is_finite()
             && d.cell >= 1e-3
             && d.w <= SIDE
             && d.h <= SIDE
             && d.x0.unsigned_abs() <= OFFSET
             && d.y0.unsigned_abs() <= OFFSET
-            && cells != usize::MAX
             && (d.w == 0) == (d.h == 0)
-            && d.bits.len() == cells.div_ceil(64);
+            && cells.is_some_and(|c| c as u64 <= MAX_CELLS && d.bits.len() == c.div_ceil(64));
         if !ok {
             return Err(format!(
                 "inconsistent footprint (cell {}, {} x {} cells at ({}, {}), {} words)",
@@ -178,37 +184,44 @@ impl Footprint {
         )
     }
 
-    fn grow_to(&mut self, lo: (i64, i64), hi: (i64, i64)) {
-        if self.w > 0
-            && lo.0 >= self.x0
-            && lo.1 >= self.y0
-            && hi.0 < self.x0 + self.w as i64
-            && hi.1 < self.y0 + self.h as i64
-        {
-            return;
+    /// Grow the grid to cover cells `lo..=hi`; false (the grid unchanged)
+    /// when that would exceed [`MAX_CELLS`] or the offset limit.
+    fn grow_to(&mut self, lo: (i64, i64), hi: (i64, i64)) -> bool {
+        // i128: cell indices saturate at the i64 range for huge coordinates.
+        let (lo, hi) = ((lo.0 as i128, lo.1 as i128), (hi.0 as i128, hi.1 as i128));
+        let (x0, y0) = (self.x0 as i128, self.y0 as i128);
+        let (w, h) = (self.w as i128, self.h as i128);
+        if w > 0 && lo.0 >= x0 && lo.1 >= y0 && hi.0 < x0 + w && hi.1 < y0 + h {
+            return true;
         }
         let (mut nx0, mut ny0, mut nx1, mut ny1) = (lo.0, lo.1, hi.0 + 1, hi.1 + 1);
-        if self.w > 0 {
-            nx0 = nx0.min(self.x0);
-            ny0 = ny0.min(self.y0);
-            nx1 = nx1.max(self.x0 + self.w as i64);
-            ny1 = ny1.max(self.y0 + self.h as i64);
+        if w > 0 {
+            nx0 = nx0.min(x0);
+            ny0 = ny0.min(y0);
+            nx1 = nx1.max(x0 + w);
+            ny1 = ny1.max(y0 + h);
             // Amortise: leave a quarter of the size as slack on the growing sides.
             let (sx, sy) = ((nx1 - nx0) / 4 + 4, (ny1 - ny0) / 4 + 4);
-            if lo.0 < self.x0 {
+            if lo.0 < x0 {
                 nx0 -= sx;
             }
-            if hi.0 >= self.x0 + self.w as i64 {
+            if hi.0 >= x0 + w {
                 nx1 += sx;
             }
-            if lo.1 < self.y0 {
+            if lo.1 < y0 {
                 ny0 -= sy;
             }
-            if hi.1 >= self.y0 + self.h as i64 {
+            if hi.1 >= y0 + h {
                 ny1 += sy;
             }
         }
-        let (nw, nh) = ((nx1 - nx0) as usize, (ny1 - ny0) as usize);
+        let fits = (nx1 - nx0) * (ny1 - ny0) <= MAX_CELLS as i128
+            && [nx0, ny0, nx1, ny1].iter().all(|v| v.abs() <= MAX_OFFSET);
+        if !fits {
+            return false;
+        }
+        let (nx0, ny0) = (nx0 as i64, ny0 as i64);
+        let (nw, nh) = ((nx1 as i64 - nx0) as usize, (ny1 as i64 - ny0) as usize);
         let mut bits = vec![0u64; (nw * nh).div_ceil(64)];
         for y in 0..self.h {
             for x in 0..self.w {
@@ -228,6 +241,7 @@ impl Footprint {
             h: nh,
             bits,
         };
+        true
     }
 
     #[inline]
@@ -263,14 +277,19 @@ impl Footprint {
         if lo.0 > hi.0 {
             return 0;
         }
-        self.grow_to(lo, hi);
+        // When the grid cannot grow that far, the points outside it are left out.
+        let _ = self.grow_to(lo, hi);
         let mut fresh = 0;
         for &p in points {
             if !p.is_finite() {
                 continue;
             }
             let (x, y) = self.index_of(p);
-            let k = (y - self.y0) as usize * self.w + (x - self.x0) as usize;
+            let (x, y) = (x as i128 - self.x0 as i128, y as i128 - self.y0 as i128);
+            if x < 0 || y < 0 || x >= self.w as i128 || y >= self.h as i128 {
+                continue;
+            }
+            let k = y as usize * self.w + x as usize;
             fresh += (self.bits[k >> 6] >> (k & 63) & 1 == 0) as usize;
             self.bits[k >> 6] |= 1 << (k & 63);
         }
@@ -708,6 +727,28 @@ mod tests {
     use crate::geometry::polygon::{contains, is_simple, signed_area};
 
     #[test]
+    fn huge_extents_are_bounded_not_a_crash() {
+        // Regression: points 30 km apart at 0.2 m cells asked for 2e10 cells,
+        // which overflowed usize on wasm32 and indexed out of bounds.
+        let mut fp = Footprint::new(0.2);
+        let pts: Vec<DVec2> = (0..60)
+            .flat_map(|i| (0..60).map(move |j| DVec2::new(i as f64 * 500.0, j as f64 * 500.0)))
+            .collect();
+        fp.mark_all(&pts);
+        assert!((fp.w as u64) * (fp.h as u64) <= MAX_CELLS);
+        // What fits is kept; huge and saturating coordinates are harmless.
+        fp.mark_all(&[DVec2::new(1e300, -1e300), DVec2::new(f64::MAX, 0.0)]);
+        let mut small = Footprint::new(0.2);
+        assert_eq!(
+            small.mark_all(&[DVec2::new(1.0, 1.0), DVec2::new(1e300, 1.0)]),
+            0
+        );
+        assert_eq!(small.mark_all(&[DVec2::new(1.0, 1.0)]), 1);
+        assert!(small.is_set(DVec2::new(1.0, 1.0)));
+        let _ = small.outline(0.5, 0.1, 64);
+    }
+
+    #[test]
     fn serialises_words_as_hex_and_rejects_inconsistent_grids() {
         let mut fp = Footprint::new(0.25);
         // Cells spread over many words, so that high bits are set.
@@ -761,7 +802,7 @@ mod tests {
         let (w, h) = (13, 9);
         let grid: Vec<bool> = (0..w * h).map(|k| k % 7 == 0 || k == 50).collect();
         let d = sq_edt(&grid, w, h);
-        for k in 0..w * h {
+        for (k, &dk) in d.iter().enumerate() {
             let (x, y) = ((k % w) as f64, (k / w) as f64);
             let best = (0..w * h)
                 .filter(|&j| grid[j])
@@ -770,7 +811,7 @@ mod tests {
                     (a - x) * (a - x) + (b - y) * (b - y)
                 })
                 .fold(f64::INFINITY, f64::min);
-            assert_eq!(d[k], best);
+            assert_eq!(dk, best);
         }
     }
 
@@ -811,7 +852,7 @@ mod tests {
     #[test]
     fn closing_bridges_gaps_narrower_than_two_alpha() {
         // Two strips 0.6 m apart: alpha 0.4 joins them, alpha 0.2 does not.
-        let pts = grid_points(|_, y| y < 2.0 || y > 2.6, 0.05, 100);
+        let pts = grid_points(|_, y| !(2.0..=2.6).contains(&y), 0.05, 100);
         let mut fp = Footprint::new(0.05);
         fp.mark_all(&pts);
         let joined = fp.outline(0.4, 0.02, 100).unwrap();

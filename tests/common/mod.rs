@@ -13,6 +13,7 @@ use polyscene::rng::Rng;
 
 /// Sample the rectangle `origin + s*u + t*v`, s in [0, a], t in [0, b], on a
 /// grid of `step` with Gaussian noise `sigma` along `u x v`.
+#[allow(clippy::too_many_arguments)]
 pub fn rect(
     out: &mut Vec<DVec3>,
     origin: DVec3,
@@ -35,6 +36,7 @@ pub fn rect(
 }
 
 /// Sample a 2D region (given by `inside`) of the plane with frame `f`.
+#[allow(clippy::too_many_arguments)]
 pub fn region(
     out: &mut Vec<DVec3>,
     f: &Frame,
