@@ -65,7 +65,8 @@ pub fn key2(x: i64, y: i64) -> u64 {
 pub fn floor_i64(x: f64) -> i64 {
     let i = x as i64;
     if (i as f64) > x {
-        i - 1
+        // Saturating: `x as i64` already saturated for x below i64::MIN.
+        i.saturating_sub(1)
     } else {
         i
     }
