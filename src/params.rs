@@ -90,14 +90,14 @@ pub struct Params {
     /// narrower than `2 * alpha` are filled. Default 0.5.
     pub alpha: f64,
     /// Concave outline radius for ground primitives (m); the ground is seen
-    /// at grazing angles with wide gaps between laser rings. Default 1.5.
+    /// at grazing angles with wide gaps between laser rings. Default 1.0.
     pub ground_alpha: f64,
     /// Raster cell size of footprints (m): the resolution of concave
     /// outlines and of the occupancy test. Default 0.2.
     pub cell: f64,
     /// Raster cell size of ground footprints (m): the ground is large and
-    /// seen at grazing angles, a coarser cell keeps its outline cheap.
-    /// Default 0.4.
+    /// seen at grazing angles; a coarser cell makes its outline cheaper.
+    /// Default 0.2.
     pub ground_cell: f64,
     /// Outline simplification tolerance (m). Default 0.1.
     pub simplify: f64,
@@ -134,10 +134,10 @@ pub struct Params {
     pub min_occupancy: f64,
 
     // --- Cascade budget ---
-    /// Most primitives one detection returns. Default 200.
+    /// Most primitives one detection returns. gpp2 default 200, gpp1 60.
     pub max_primitives: usize,
     /// The cascade stops after this many rounds in a row found nothing
-    /// acceptable (what is left is clutter). Default 24.
+    /// acceptable (what is left is clutter). Default 10.
     pub max_rejections: usize,
     /// Work budget of one detection, in point-to-plane distance evaluations
     /// (about a nanosecond each natively). Default 2e9.
