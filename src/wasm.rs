@@ -167,6 +167,8 @@ export interface ScanReport {
   explainedByExpansion: number;
   /** Points given to detection (the rest). */
   sentToDetection: number;
+  /** Of those, points taken by the polygons detection added. */
+  explainedByDetection: number;
   /** Ids of new polygons. */
   added: number[];
   /** Ids of existing polygons that grew. */

@@ -4,6 +4,7 @@
 mod common;
 
 use glam::{DMat4, DVec3};
+use polyscene::detect::NO_PRIMITIVE;
 use polyscene::eval::{self, EvalOptions, GtSurface};
 use polyscene::geometry::Polygon3;
 use polyscene::params::{HullKind, Params};
@@ -48,6 +49,16 @@ fn run(d: &Drive, params: Params) -> Run {
         assert_eq!(r.polygon_count, scenario.primitives().len());
         assert_eq!(r.points, scan.len());
         assert_eq!(r.explained_by_expansion + r.sent_to_detection, r.points);
+        assert!(r.explained_by_detection <= r.sent_to_detection);
+        let labelled = scenario
+            .last_labels()
+            .iter()
+            .filter(|&&l| l != NO_PRIMITIVE)
+            .count();
+        assert_eq!(
+            labelled,
+            r.explained_by_expansion + r.explained_by_detection
+        );
         if k >= 5 {
             shares.push(r.explained_by_expansion as f64 / r.points as f64);
         }

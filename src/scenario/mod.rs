@@ -50,6 +50,9 @@ pub struct ScanReport {
     pub explained_by_expansion: usize,
     /// Points given to detection (the rest).
     pub sent_to_detection: usize,
+    /// Of those, points taken by the primitives detection added (the others
+    /// stay unexplained: clutter, vegetation, too-small surfaces).
+    pub explained_by_detection: usize,
     /// Ids of new primitives.
     pub added: Vec<u32>,
     /// Ids of existing primitives that grew.
@@ -178,6 +181,7 @@ impl Scenario {
             for (k, &l) in det.labels.iter().enumerate() {
                 if l == local {
                     labels[rest[k] as usize] = prim.id;
+                    report.explained_by_detection += 1;
                 }
             }
             report.added.push(prim.id);

@@ -9,7 +9,7 @@ import { ps, repoRoot } from "./common.mjs";
 import { optionDocs, documentedDefault, sameValue, optionsTable } from "../../scripts/gen-js-docs.mjs";
 
 const POLYGON_KEYS = ["id", "normal", "offset", "vertices", "area", "support", "density", "ground", "bornScan", "lastScan"];
-const REPORT_KEYS = ["scan", "points", "explainedByExpansion", "sentToDetection", "added", "grown", "merged", "polygonCount", "totalArea", "timeMs"];
+const REPORT_KEYS = ["scan", "points", "explainedByExpansion", "sentToDetection", "explainedByDetection", "added", "grown", "merged", "polygonCount", "totalArea", "timeMs"];
 
 test("exports", () => {
   for (const name of ["Scenario", "Simulation", "ScanIterator", "detect", "simulate", "defaultOptions", "version"]) {
@@ -34,6 +34,7 @@ test("reports, polygons and labels of a street drive", () => {
     assert.equal(report.scan, k);
     assert.equal(report.points, points.length / 4);
     assert.equal(report.explainedByExpansion + report.sentToDetection, report.points);
+    assert.ok(report.explainedByDetection <= report.sentToDetection);
     for (const m of report.merged) assert.deepEqual(Object.keys(m), ["kept", "removed"]);
     const labels = scenario.lastLabels();
     assert.ok(labels instanceof Uint32Array);
@@ -47,7 +48,7 @@ test("reports, polygons and labels of a street drive", () => {
       }
     }
     // Points taken by expansion keep their label; detection labels its support.
-    assert.ok(explained >= report.explainedByExpansion, `${explained} labelled, ${report.explainedByExpansion} by expansion`);
+    assert.equal(explained, report.explainedByExpansion + report.explainedByDetection, "labelled = expansion + detection");
     assert.ok(explained > 0.1 * labels.length, `${explained} of ${labels.length} points explained`);
   }
   assert.equal(scenario.scans, 3);

@@ -62,6 +62,9 @@ class App {
     this.fileSources = new Map(); // GUI name -> { label, scans, id }
     this.loads = 0;
     this.latest = { polygons: [], mesh: null, report: null, index: -1, total: 0 };
+    // The reports of the current source's scans (the numbers behind the
+    // sparklines), kept for inspection: window.polyscene.app.reports.
+    this.reports = [];
 
     this.view = new SceneView($('viewport'));
     this.client = new PolysceneClient();
@@ -188,6 +191,7 @@ class App {
     this.view.reset();
     this.view.setFollow(true);
     this.latest = { polygons: [], mesh: null, report: null, index: -1, total: source.total };
+    this.reports = [];
     this.done = false;
     document.body.classList.remove('done');
     $('source-label').textContent = source.label;
@@ -207,6 +211,8 @@ class App {
     this.view.showScan(m);
     const r = m.report;
     this.latest.report = r;
+    this.reports.push(r);
+    if (this.reports.length > 10_000) this.reports.splice(0, 5_000);
     this.latest.index = m.index;
     this.latest.total = m.total;
     if (m.polygons) this.latest.polygons = m.polygons;
