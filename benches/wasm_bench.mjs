@@ -3,7 +3,7 @@
 // (not part of `make test`):
 //   1. a 100-scan simulated street drive (seed 1, gpp2): median per-scan
 //      `addScan` time in wasm vs the native CLI replay of the same scans;
-//   2. one-shot `detect` on both real scans in ../shared/data (stride 4).
+//   2. one-shot `detect` on both real scans bundled in www/data (stride 4).
 // Both sides time the same thing: the core's own clock (`timeMs.total` of
 // each scan report, `timeMs` of the CLI's detect output); wasm wall time
 // (JS call included: copying the points in, the report out) is shown too.
@@ -75,7 +75,7 @@ const same = JSON.stringify(counts) === JSON.stringify(nativeCounts);
 // 2. One-shot detection on the real scans.
 const detectRows = [];
 for (const file of ["ouster_os1_64_legacy_f12073.bin", "ouster_os0_128_single_scan_016.bin"]) {
-  const p = path.resolve(root, "../shared/data", file);
+  const p = path.resolve(root, "www/data", file);
   if (!fs.existsSync(p)) {
     console.error(`missing ${p}`);
     process.exit(1);

@@ -7,7 +7,9 @@ import path from "node:path";
 import { fileURLToPath } from "node:url";
 
 export const repoRoot = path.resolve(path.dirname(fileURLToPath(import.meta.url)), "../..");
-export const dataDir = path.resolve(repoRoot, "../shared/data");
+// The real scans ship with the page (www/data, with their licences), so a
+// fresh clone has them.
+export const dataDir = path.resolve(repoRoot, "www/data");
 
 const pkgDir = path.join(repoRoot, "pkg/node");
 if (!fs.existsSync(path.join(pkgDir, "polyscene_bg.wasm"))) {
@@ -33,11 +35,11 @@ export function tempDir(name) {
   return dir;
 }
 
-/** A real scan of /work/shared/data (little-endian f32, stride 4), or a clear failure. */
+/** A real scan of www/data (little-endian f32, stride 4), or a clear failure. */
 export function realScan(file) {
   const p = path.join(dataDir, file);
   if (!fs.existsSync(p)) {
-    throw new Error(`real scan ${p} is missing: the tests read ../shared/data relative to the repository`);
+    throw new Error(`real scan ${p} is missing: the tests read the scans bundled in www/data`);
   }
   const bytes = fs.readFileSync(p);
   return new Float32Array(bytes.buffer.slice(bytes.byteOffset, bytes.byteOffset + bytes.byteLength));
