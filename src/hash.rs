@@ -12,7 +12,14 @@ pub struct GridHasher(u64);
 impl Hasher for GridHasher {
     #[inline]
     fn finish(&self) -> u64 {
-        self.0
+        // Final avalanche (the splitmix64 mixer): the multiply alone leaves
+        // the low bits depending only on the key's low bits (the x cell of a
+        // packed key), and the table indexes buckets by the low bits, so
+        // every cell of one x column would probe the same group.
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
     }
     #[inline]
     fn write(&mut self, bytes: &[u8]) {

@@ -31,101 +31,219 @@ pub fn largest_cluster(points: &[DVec2], tol: f64) -> Vec<u32> {
 /// Cluster label of every point (labels are cell ids of the cluster's root,
 /// so not dense) and the size of each label.
 pub fn clusters(points: &[DVec2], tol: f64) -> (Vec<u32>, Vec<u32>) {
-    let n = points.len();
-    if n == 0 {
-        return (Vec::new(), Vec::new());
-    }
-    let tol = if tol.is_finite() && tol > 0.0 {
-        tol
-    } else {
-        1e-9
-    };
-    let side = tol / std::f64::consts::SQRT_2;
-    // Cell ids in first-seen order; looked up in a dense array when the
-    // bounding box is small enough (the usual case), else in a hash map.
-    let cell_of_point = |p: &DVec2| (floor_i64(p.x / side), floor_i64(p.y / side));
-    let (mut lo, mut hi) = ((i64::MAX, i64::MAX), (i64::MIN, i64::MIN));
-    for p in points {
-        let (x, y) = cell_of_point(p);
-        lo = (lo.0.min(x), lo.1.min(y));
-        hi = (hi.0.max(x), hi.1.max(y));
-    }
-    let (gw, gh) = ((hi.0 - lo.0 + 1) as u128, (hi.1 - lo.1 + 1) as u128);
-    let dense = gw * gh <= 4 * n as u128 + 65_536;
-    let mut lookup = CellLookup::new(dense, lo, (gw as usize, gh as usize));
-    let mut cell_key: Vec<(i64, i64)> = Vec::new();
-    let mut cell_of = Vec::with_capacity(n);
-    for p in points {
-        let (cx, cy) = cell_of_point(p);
-        let id = lookup.get_or_insert(cx, cy, || {
-            cell_key.push((cx, cy));
-            (cell_key.len() - 1) as u32
-        });
-        cell_of.push(id);
-    }
-    let cells = cell_key.len();
-    // CSR of points per cell.
-    let mut start = vec![0u32; cells + 1];
-    for &c in &cell_of {
-        start[c as usize + 1] += 1;
-    }
-    for i in 0..cells {
-        start[i + 1] += start[i];
-    }
-    let mut fill = start.clone();
-    let mut items = vec![0u32; n];
-    for (i, &c) in cell_of.iter().enumerate() {
-        items[fill[c as usize] as usize] = i as u32;
-        fill[c as usize] += 1;
-    }
-    // Half neighbourhood (each unordered pair once) whose boxes are < tol apart.
-    let mut offsets = Vec::new();
-    for dx in -2i64..=2 {
-        for dy in -2i64..=2 {
-            if (dx, dy) <= (0, 0) {
-                continue;
+    Clusterer::default().clusters(points, tol)
+}
+
+/// [`clusters`] with its working memory kept between calls: the detection
+/// cascade clusters once per round, and fresh multi-megabyte buffers every
+/// round cost more in page faults than the clustering itself.
+#[derive(Default)]
+pub struct Clusterer {
+    cell_xy: Vec<(i64, i64)>,
+    ids: Vec<u32>,
+    map: GridMap<u64, u32>,
+    cell_key: Vec<(i64, i64)>,
+    cell_of: Vec<u32>,
+    start: Vec<u32>,
+    fill: Vec<u32>,
+    items: Vec<u32>,
+    bbox: Vec<[f64; 4]>,
+    near: Vec<DVec2>,
+    parent: Vec<u32>,
+}
+
+impl Clusterer {
+    /// See [`clusters`].
+    pub fn clusters(&mut self, points: &[DVec2], tol: f64) -> (Vec<u32>, Vec<u32>) {
+        let n = points.len();
+        if n == 0 {
+            return (Vec::new(), Vec::new());
+        }
+        let tol = if tol.is_finite() && tol > 0.0 {
+            tol
+        } else {
+            1e-9
+        };
+        let side = tol / std::f64::consts::SQRT_2;
+        let inv = 1.0 / side;
+        // Cell coordinates, once per point.
+        self.cell_xy.clear();
+        let (mut lo, mut hi) = ((i64::MAX, i64::MAX), (i64::MIN, i64::MIN));
+        for p in points {
+            let c = (floor_i64(p.x * inv), floor_i64(p.y * inv));
+            lo = (lo.0.min(c.0), lo.1.min(c.1));
+            hi = (hi.0.max(c.0), hi.1.max(c.1));
+            self.cell_xy.push(c);
+        }
+        // Cell ids in first-seen order; looked up in a dense array when the
+        // bounding box is small enough (the usual case), else in a hash map.
+        let (gw, gh) = (
+            (hi.0 as i128 - lo.0 as i128 + 1) as u128,
+            (hi.1 as i128 - lo.1 as i128 + 1) as u128,
+        );
+        let dense = gw * gh <= 4 * n as u128 + 65_536;
+        let (gw, gh) = if dense {
+            (gw as usize, gh as usize)
+        } else {
+            (0, 0)
+        };
+        self.cell_key.clear();
+        self.cell_of.clear();
+        if dense {
+            if self.ids.len() < gw * gh {
+                self.ids.resize(gw * gh, u32::MAX);
             }
-            let gx = (dx.abs() - 1).max(0) as f64 * side;
-            let gy = (dy.abs() - 1).max(0) as f64 * side;
-            if gx * gx + gy * gy < tol * tol {
-                offsets.push((dx, dy));
+            for &(cx, cy) in &self.cell_xy {
+                let k = (cy - lo.1) as usize * gw + (cx - lo.0) as usize;
+                if self.ids[k] == u32::MAX {
+                    self.ids[k] = self.cell_key.len() as u32;
+                    self.cell_key.push((cx, cy));
+                }
+                self.cell_of.push(self.ids[k]);
+            }
+        } else {
+            self.map.clear();
+            for &(cx, cy) in &self.cell_xy {
+                let next = self.cell_key.len() as u32;
+                let id = *self.map.entry(key2(cx, cy)).or_insert(next);
+                if id == next {
+                    self.cell_key.push((cx, cy));
+                }
+                self.cell_of.push(id);
             }
         }
-    }
-    let mut parent: Vec<u32> = (0..cells as u32).collect();
-    let tol2 = tol * tol;
-    for c in 0..cells {
-        let (cx, cy) = cell_key[c];
-        let a = &items[start[c] as usize..start[c + 1] as usize];
-        for &(dx, dy) in &offsets {
-            let Some(nb) = lookup.get(cx + dx, cy + dy) else {
-                continue;
-            };
-            let (ra, rb) = (find(&mut parent, c as u32), find(&mut parent, nb));
-            if ra == rb {
-                continue;
+        let lookup = |ids: &[u32], map: &GridMap<u64, u32>, x: i64, y: i64| -> Option<u32> {
+            if dense {
+                let (dx, dy) = (x.wrapping_sub(lo.0), y.wrapping_sub(lo.1));
+                if dx < 0 || dy < 0 || dx as usize >= gw || dy as usize >= gh {
+                    return None;
+                }
+                let id = ids[dy as usize * gw + dx as usize];
+                (id != u32::MAX).then_some(id)
+            } else {
+                map.get(&key2(x, y)).copied()
             }
-            let b = &items[start[nb as usize] as usize..start[nb as usize + 1] as usize];
-            let close = a.iter().any(|&i| {
-                let p = points[i as usize];
-                b.iter()
-                    .any(|&j| (points[j as usize] - p).length_squared() < tol2)
-            });
-            if close {
-                // Union by smaller root id: deterministic.
-                let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
-                parent[hi as usize] = lo;
+        };
+        let cells = self.cell_key.len();
+        // CSR of points per cell, and each cell's bounding box.
+        self.start.clear();
+        self.start.resize(cells + 1, 0);
+        self.bbox.clear();
+        self.bbox.resize(
+            cells,
+            [
+                f64::INFINITY,
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+                f64::NEG_INFINITY,
+            ],
+        );
+        for (p, &c) in points.iter().zip(&self.cell_of) {
+            self.start[c as usize + 1] += 1;
+            let b = &mut self.bbox[c as usize];
+            b[0] = b[0].min(p.x);
+            b[1] = b[1].min(p.y);
+            b[2] = b[2].max(p.x);
+            b[3] = b[3].max(p.y);
+        }
+        for i in 0..cells {
+            self.start[i + 1] += self.start[i];
+        }
+        self.fill.clear();
+        self.fill.extend_from_slice(&self.start[..cells]);
+        self.items.clear();
+        self.items.resize(n, 0);
+        for (i, &c) in self.cell_of.iter().enumerate() {
+            self.items[self.fill[c as usize] as usize] = i as u32;
+            self.fill[c as usize] += 1;
+        }
+        // Half neighbourhood (each unordered pair once) whose boxes are < tol apart.
+        let mut offsets = Vec::new();
+        for dx in -2i64..=2 {
+            for dy in -2i64..=2 {
+                if (dx, dy) <= (0, 0) {
+                    continue;
+                }
+                let gx = (dx.abs() - 1).max(0) as f64 * side;
+                let gy = (dy.abs() - 1).max(0) as f64 * side;
+                if gx * gx + gy * gy < tol * tol {
+                    offsets.push((dx, dy));
+                }
             }
         }
+        // Most neighbour pairs are settled by the cells' boxes alone; the rest
+        // compare only the points of each cell within `tol` of the other's box
+        // (near the sensor a cell holds hundreds of points, and two diagonal
+        // cells without a close pair would otherwise cost the product of
+        // their sizes).
+        let box_gap2 = |p: DVec2, b: &[f64; 4]| {
+            let dx = (b[0] - p.x).max(p.x - b[2]).max(0.0);
+            let dy = (b[1] - p.y).max(p.y - b[3]).max(0.0);
+            dx * dx + dy * dy
+        };
+        self.parent.clear();
+        self.parent.extend(0..cells as u32);
+        let tol2 = tol * tol;
+        let (parent, near) = (&mut self.parent, &mut self.near);
+        for c in 0..cells {
+            let (cx, cy) = self.cell_key[c];
+            let a = &self.items[self.start[c] as usize..self.start[c + 1] as usize];
+            for &(dx, dy) in &offsets {
+                let Some(nb) = lookup(
+                    &self.ids,
+                    &self.map,
+                    cx.wrapping_add(dx),
+                    cy.wrapping_add(dy),
+                ) else {
+                    continue;
+                };
+                let (ra, rb) = (find(parent, c as u32), find(parent, nb));
+                if ra == rb {
+                    continue;
+                }
+                let (ba, bb) = (&self.bbox[c], &self.bbox[nb as usize]);
+                let gx = (bb[0] - ba[2]).max(ba[0] - bb[2]).max(0.0);
+                let gy = (bb[1] - ba[3]).max(ba[1] - bb[3]).max(0.0);
+                if gx * gx + gy * gy >= tol2 {
+                    continue;
+                }
+                let b = &self.items
+                    [self.start[nb as usize] as usize..self.start[nb as usize + 1] as usize];
+                near.clear();
+                near.extend(
+                    a.iter()
+                        .map(|&i| points[i as usize])
+                        .filter(|&p| box_gap2(p, bb) < tol2),
+                );
+                let close = !near.is_empty()
+                    && b.iter().any(|&j| {
+                        let q = points[j as usize];
+                        box_gap2(q, ba) < tol2
+                            && near.iter().any(|&p| (q - p).length_squared() < tol2)
+                    });
+                if close {
+                    // Union by smaller root id: deterministic.
+                    let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
+                    parent[hi as usize] = lo;
+                }
+            }
+        }
+        // Leave the dense id array all-empty for the next call (only the
+        // cells used here were set).
+        if dense {
+            for &(cx, cy) in &self.cell_key {
+                self.ids[(cy - lo.1) as usize * gw + (cx - lo.0) as usize] = u32::MAX;
+            }
+        }
+        let mut size = vec![0u32; cells];
+        let mut root_of_point = Vec::with_capacity(n);
+        for &c in &self.cell_of {
+            let r = find(parent, c);
+            size[r as usize] += 1;
+            root_of_point.push(r);
+        }
+        (root_of_point, size)
     }
-    let mut size = vec![0u32; cells];
-    let mut root_of_point = Vec::with_capacity(n);
-    for &c in &cell_of {
-        let r = find(&mut parent, c);
-        size[r as usize] += 1;
-        root_of_point.push(r);
-    }
-    (root_of_point, size)
 }
 
 fn find(parent: &mut [u32], mut x: u32) -> u32 {
@@ -135,59 +253,6 @@ fn find(parent: &mut [u32], mut x: u32) -> u32 {
         x = gp;
     }
     x
-}
-
-/// Cell id lookup: a dense array over the cells' bounding box, or a hash map.
-enum CellLookup {
-    Dense {
-        lo: (i64, i64),
-        w: usize,
-        h: usize,
-        ids: Vec<u32>,
-    },
-    Sparse(GridMap<u64, u32>),
-}
-
-impl CellLookup {
-    fn new(dense: bool, lo: (i64, i64), (w, h): (usize, usize)) -> Self {
-        if dense {
-            CellLookup::Dense {
-                lo,
-                w,
-                h,
-                ids: vec![u32::MAX; w * h],
-            }
-        } else {
-            CellLookup::Sparse(GridMap::default())
-        }
-    }
-
-    fn get(&self, x: i64, y: i64) -> Option<u32> {
-        match self {
-            CellLookup::Dense { lo, w, h, ids } => {
-                let (dx, dy) = (x - lo.0, y - lo.1);
-                if dx < 0 || dy < 0 || dx as usize >= *w || dy as usize >= *h {
-                    return None;
-                }
-                let id = ids[dy as usize * w + dx as usize];
-                (id != u32::MAX).then_some(id)
-            }
-            CellLookup::Sparse(map) => map.get(&key2(x, y)).copied(),
-        }
-    }
-
-    fn get_or_insert(&mut self, x: i64, y: i64, new: impl FnOnce() -> u32) -> u32 {
-        match self {
-            CellLookup::Dense { lo, w, ids, .. } => {
-                let k = (y - lo.1) as usize * *w + (x - lo.0) as usize;
-                if ids[k] == u32::MAX {
-                    ids[k] = new();
-                }
-                ids[k]
-            }
-            CellLookup::Sparse(map) => *map.entry(key2(x, y)).or_insert_with(new),
-        }
-    }
 }
 
 #[cfg(test)]

@@ -114,6 +114,7 @@ impl<'p> Detector<'p> {
         let mut steps = Vec::new();
         let max_rounds = 4 * p.max_primitives + 64;
         let mut rejections = 0;
+        let mut clusterer = cluster::Clusterer::default();
         for _ in 0..max_rounds {
             if primitives.len() >= p.max_primitives
                 || pool.work >= p.max_work
@@ -137,7 +138,7 @@ impl<'p> Detector<'p> {
                 .iter()
                 .map(|&i| frame.to_local(pts[i as usize].as_dvec3()))
                 .collect();
-            let (comp, sizes) = cluster::clusters(&flat, p.cluster_tolerance);
+            let (comp, sizes) = clusterer.clusters(&flat, p.cluster_tolerance);
             let largest = comp
                 .iter()
                 .copied()

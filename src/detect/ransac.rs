@@ -23,7 +23,7 @@
 //!   `[24, max_hypotheses]`.
 //! - **Local optimisation and confirmation.** The best hypothesis is refit
 //!   by robust least squares (f64 PCA, trimmed) on its inliers among a
-//!   random subsample of at most 65 536 points, and the refined plane is
+//!   random subsample of at most 16 384 points, and the refined plane is
 //!   counted once on all remaining points.
 //!
 //! Bounds on work per primitive: at most `max_hypotheses * k` distance
@@ -73,7 +73,7 @@ const START_K: usize = 4096;
 const MIN_RANKABLE: usize = 40;
 const MIN_HYPOTHESES: usize = 24;
 /// Most points the local optimisation (robust refit) looks at.
-const LO_SAMPLE: usize = 65_536;
+const LO_SAMPLE: usize = 16_384;
 
 impl<'a> PlanePool<'a> {
     /// All of `pts` in play, shuffled once with `rng`.
@@ -84,21 +84,35 @@ impl<'a> PlanePool<'a> {
             let j = rng.below(i + 1);
             order.swap(i, j);
         }
-        let rx = order.iter().map(|&i| pts[i as usize].x).collect();
-        let ry = order.iter().map(|&i| pts[i as usize].y).collect();
-        let rz = order.iter().map(|&i| pts[i as usize].z).collect();
+        let (mut rx, mut ry, mut rz) = (
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+            Vec::with_capacity(n),
+        );
+        for &i in &order {
+            let p = pts[i as usize];
+            rx.push(p.x);
+            ry.push(p.y);
+            rz.push(p.z);
+        }
         // Sampling voxels (ids in first-seen order of the original indices).
         let inv = 1.0 / sample_radius.max(1e-3);
         let mut map: GridMap<u64, u32> = GridMap::default();
         let mut cell_of = Vec::with_capacity(n);
+        // Consecutive points of a scan are mostly neighbours along a ring, in
+        // one voxel: remember the last key and skip the map for repeats.
+        let mut last = (u64::MAX, 0u32);
         for p in pts {
             let k = key3(
                 crate::hash::floor_i64(p.x as f64 * inv),
                 crate::hash::floor_i64(p.y as f64 * inv),
                 crate::hash::floor_i64(p.z as f64 * inv),
             );
-            let next = map.len() as u32;
-            cell_of.push(*map.entry(k).or_insert(next));
+            if k != last.0 {
+                let next = map.len() as u32;
+                last = (k, *map.entry(k).or_insert(next));
+            }
+            cell_of.push(last.1);
         }
         let cells = map.len();
         let mut cell_start = vec![0u32; cells + 1];
@@ -374,36 +388,39 @@ impl<'a> PlanePool<'a> {
 
     /// Pool positions of the inliers of `plane` among the first `k` points.
     fn collect_prefix(&mut self, plane: &LocalPlane, k: usize) -> Vec<u32> {
-        let (nx, ny, nz) = (
-            plane.normal.x as f32,
-            plane.normal.y as f32,
-            plane.normal.z as f32,
-        );
-        let (d, t) = (plane.offset as f32, plane.threshold as f32);
         self.work += k as u64;
-        (0..k as u32)
-            .filter(|&i| {
-                let i = i as usize;
-                (nx * self.rx[i] + ny * self.ry[i] + nz * self.rz[i] + d).abs() < t
-            })
-            .collect()
+        self.inliers_in(plane, k)
     }
 
     /// Pool positions of all inliers of `plane`.
     fn collect(&mut self, plane: &LocalPlane) -> Vec<u32> {
+        self.work += self.rx.len() as u64;
+        self.inliers_in(plane, self.rx.len())
+    }
+
+    /// Pool positions of the inliers of `plane` among the first `k` pool
+    /// entries. Branch-free: every position is written and the length
+    /// advances only for inliers (inliers are a minority, so a branch per
+    /// point would mispredict often).
+    fn inliers_in(&self, plane: &LocalPlane, k: usize) -> Vec<u32> {
         let (nx, ny, nz) = (
             plane.normal.x as f32,
             plane.normal.y as f32,
             plane.normal.z as f32,
         );
         let (d, t) = (plane.offset as f32, plane.threshold as f32);
-        self.work += self.rx.len() as u64;
         let mut out = Vec::new();
-        for i in 0..self.rx.len() {
-            let v = nx * self.rx[i] + ny * self.ry[i] + nz * self.rz[i] + d;
-            if v.abs() < t {
-                out.push(i as u32);
+        let mut buf = [0u32; 1024];
+        for lo in (0..k).step_by(1024) {
+            let hi = k.min(lo + 1024);
+            let (xs, ys, zs) = (&self.rx[lo..hi], &self.ry[lo..hi], &self.rz[lo..hi]);
+            let mut len = 0usize;
+            for i in 0..xs.len() {
+                let v = nx * xs[i] + ny * ys[i] + nz * zs[i] + d;
+                buf[len] = (lo + i) as u32;
+                len += (v.abs() < t) as usize;
             }
+            out.extend_from_slice(&buf[..len]);
         }
         out
     }

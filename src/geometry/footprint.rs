@@ -178,10 +178,7 @@ impl Footprint {
 
     #[inline]
     fn index_of(&self, p: DVec2) -> (i64, i64) {
-        (
-            crate::hash::floor_i64(p.x / self.cell),
-            crate::hash::floor_i64(p.y / self.cell),
-        )
+        cell_index(p, 1.0 / self.cell)
     }
 
     /// Grow the grid to cover cells `lo..=hi`; false (the grid unchanged)
@@ -264,13 +261,14 @@ impl Footprint {
     /// Set the cells of all `points` (frame coordinates, metres); returns
     /// how many cells were newly set. Non-finite points are ignored.
     pub fn mark_all(&mut self, points: &[DVec2]) -> usize {
+        let inv = 1.0 / self.cell;
         let mut lo = (i64::MAX, i64::MAX);
         let mut hi = (i64::MIN, i64::MIN);
         for &p in points {
             if !p.is_finite() {
                 continue;
             }
-            let (x, y) = self.index_of(p);
+            let (x, y) = cell_index(p, inv);
             lo = (lo.0.min(x), lo.1.min(y));
             hi = (hi.0.max(x), hi.1.max(y));
         }
@@ -284,7 +282,7 @@ impl Footprint {
             if !p.is_finite() {
                 continue;
             }
-            let (x, y) = self.index_of(p);
+            let (x, y) = cell_index(p, inv);
             let (x, y) = (x as i128 - self.x0 as i128, y as i128 - self.y0 as i128);
             if x < 0 || y < 0 || x >= self.w as i128 || y >= self.h as i128 {
                 continue;
@@ -437,12 +435,21 @@ pub struct Region {
     inside: Vec<bool>,
 }
 
+/// The footprint cell of `p` for cells of side `1 / inv` (every footprint
+/// and region lookup goes through here, so they agree to the last bit).
+#[inline]
+fn cell_index(p: DVec2, inv: f64) -> (i64, i64) {
+    (
+        crate::hash::floor_i64(p.x * inv),
+        crate::hash::floor_i64(p.y * inv),
+    )
+}
+
 impl Region {
     /// Does the footprint cell under `p` belong to the region? Uses the
     /// footprint's own cell indexing, so it agrees exactly with `mark_all`.
     pub fn contains(&self, p: DVec2) -> bool {
-        let ix = crate::hash::floor_i64(p.x / self.cell);
-        let iy = crate::hash::floor_i64(p.y / self.cell);
+        let (ix, iy) = cell_index(p, 1.0 / self.cell);
         let x = (ix - self.base.0).div_euclid(self.factor) + self.margin;
         let y = (iy - self.base.1).div_euclid(self.factor) + self.margin;
         x >= 0
