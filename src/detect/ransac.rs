@@ -60,6 +60,15 @@ pub struct PlanePool<'a> {
     cell_of: Vec<u32>,
     cell_start: Vec<u32>,
     cell_items: Vec<u32>,
+    /// Coordinates in `cell_items` order (NaN once dead): the full inlier
+    /// collection reads only the voxels a plane's slab crosses.
+    cell_pts: Vec<Vec3>,
+    /// Position of each original index in `cell_items`.
+    cell_pos_of: Vec<u32>,
+    /// Bounding box of each voxel's points (centre, half extent), f64.
+    cell_box: Vec<(DVec3, DVec3)>,
+    /// Live points per voxel.
+    cell_live: Vec<u32>,
     rng: Rng,
     /// Points still in play (the arrays may also hold dead ones, as NaN).
     live: usize,
@@ -132,7 +141,30 @@ impl<'a> PlanePool<'a> {
         for (pos, &i) in order.iter().enumerate() {
             pos_of[i as usize] = pos as u32;
         }
+        let cell_pts: Vec<Vec3> = cell_items.iter().map(|&i| pts[i as usize]).collect();
+        let mut cell_pos_of = vec![0u32; n];
+        for (pos, &i) in cell_items.iter().enumerate() {
+            cell_pos_of[i as usize] = pos as u32;
+        }
+        // Boxes from the points themselves, not from the voxel keys (keys
+        // wrap for coordinates beyond 2^21 voxels, boxes never lie).
+        let mut cell_box = Vec::with_capacity(cells);
+        let mut cell_live = Vec::with_capacity(cells);
+        for c in 0..cells {
+            let members = &cell_pts[cell_start[c] as usize..cell_start[c + 1] as usize];
+            let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+            for p in members {
+                lo = lo.min(p.as_dvec3());
+                hi = hi.max(p.as_dvec3());
+            }
+            cell_box.push(((lo + hi) * 0.5, (hi - lo) * 0.5));
+            cell_live.push(members.len() as u32);
+        }
         PlanePool {
+            cell_pts,
+            cell_pos_of,
+            cell_box,
+            cell_live,
             live: n,
             pos_of,
             pts,
@@ -165,6 +197,8 @@ impl<'a> PlanePool<'a> {
             }
             self.alive[i as usize] = false;
             self.live -= 1;
+            self.cell_pts[self.cell_pos_of[i as usize] as usize] = Vec3::NAN;
+            self.cell_live[self.cell_of[i as usize] as usize] -= 1;
             let pos = self.pos_of[i as usize] as usize;
             self.rx[pos] = f32::NAN;
             self.ry[pos] = f32::NAN;
@@ -274,8 +308,7 @@ impl<'a> PlanePool<'a> {
         if inliers.len() < params.min_inliers.max(3) {
             return None;
         }
-        let originals = inliers.iter().map(|&r| self.ridx[r as usize]).collect();
-        Some((plane, originals))
+        Some((plane, inliers))
     }
 
     /// Do at least 30 % of the live points of voxel `cell` lie on `plane`?
@@ -392,16 +425,46 @@ impl<'a> PlanePool<'a> {
         self.inliers_in(plane, k)
     }
 
-    /// Pool positions of all inliers of `plane`.
+    /// All inliers of `plane` (original indices, in voxel order). Only the
+    /// voxels whose point box reaches within the threshold of the plane are
+    /// read: a plane's slab crosses a small share of a street's voxels, so
+    /// this costs far less than a pass over every remaining point.
     fn collect(&mut self, plane: &LocalPlane) -> Vec<u32> {
-        self.work += self.rx.len() as u64;
-        self.inliers_in(plane, self.rx.len())
+        let (nx, ny, nz) = (
+            plane.normal.x as f32,
+            plane.normal.y as f32,
+            plane.normal.z as f32,
+        );
+        let (d, t) = (plane.offset as f32, plane.threshold as f32);
+        let an = plane.normal.abs();
+        let mut out = Vec::new();
+        for (c, &(centre, half)) in self.cell_box.iter().enumerate() {
+            if self.cell_live[c] == 0 {
+                continue;
+            }
+            self.work += 1;
+            // Distance from the centre, less the box's reach along the
+            // normal, with a margin for the f32 point test below.
+            let reach = an.dot(half) + plane.threshold + 1e-3 + 1e-6 * centre.abs().max_element();
+            if (plane.normal.dot(centre) + plane.offset).abs() > reach {
+                continue;
+            }
+            let (lo, hi) = (self.cell_start[c] as usize, self.cell_start[c + 1] as usize);
+            self.work += (hi - lo) as u64;
+            for (k, p) in self.cell_pts[lo..hi].iter().enumerate() {
+                let v = nx * p.x + ny * p.y + nz * p.z + d;
+                if v.abs() < t {
+                    out.push(self.cell_items[lo + k]);
+                }
+            }
+        }
+        out
     }
 
     /// Pool positions of the inliers of `plane` among the first `k` pool
-    /// entries. Branch-free: every position is written and the length
-    /// advances only for inliers (inliers are a minority, so a branch per
-    /// point would mispredict often).
+    /// entries: the test runs 64 entries at a time into a bit mask (a shape
+    /// that vectorises like [`PlanePool::count`]), then the set bits are
+    /// listed; inliers are a minority, so most masks are sparse or empty.
     fn inliers_in(&self, plane: &LocalPlane, k: usize) -> Vec<u32> {
         let (nx, ny, nz) = (
             plane.normal.x as f32,
@@ -410,17 +473,25 @@ impl<'a> PlanePool<'a> {
         );
         let (d, t) = (plane.offset as f32, plane.threshold as f32);
         let mut out = Vec::new();
-        let mut buf = [0u32; 1024];
-        for lo in (0..k).step_by(1024) {
-            let hi = k.min(lo + 1024);
-            let (xs, ys, zs) = (&self.rx[lo..hi], &self.ry[lo..hi], &self.rz[lo..hi]);
-            let mut len = 0usize;
-            for i in 0..xs.len() {
-                let v = nx * xs[i] + ny * ys[i] + nz * zs[i] + d;
-                buf[len] = (lo + i) as u32;
-                len += (v.abs() < t) as usize;
+        let (xs, ys, zs) = (&self.rx[..k], &self.ry[..k], &self.rz[..k]);
+        let (cx, cy, cz) = (xs.chunks_exact(64), ys.chunks_exact(64), zs.chunks_exact(64));
+        let tail = cx.remainder().len();
+        for (c, ((x, y), z)) in cx.zip(cy).zip(cz).enumerate() {
+            let mut m = 0u64;
+            for l in 0..64 {
+                let v = nx * x[l] + ny * y[l] + nz * z[l] + d;
+                m |= ((v.abs() < t) as u64) << l;
             }
-            out.extend_from_slice(&buf[..len]);
+            while m != 0 {
+                out.push((c * 64) as u32 + m.trailing_zeros());
+                m &= m - 1;
+            }
+        }
+        for i in k - tail..k {
+            let v = nx * xs[i] + ny * ys[i] + nz * zs[i] + d;
+            if v.abs() < t {
+                out.push(i as u32);
+            }
         }
         out
     }
