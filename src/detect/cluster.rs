@@ -34,6 +34,13 @@ pub fn clusters(points: &[DVec2], tol: f64) -> (Vec<u32>, Vec<u32>) {
     Clusterer::default().clusters(points, tol)
 }
 
+/// Cell grids up to this many cells (plus four per point) are indexed by a
+/// dense array (8 MiB at most, kept between calls and cleared cell by cell),
+/// larger ones by a hash map: a plane slicing a whole street scatters a few
+/// thousand inliers over 10^5 cells, where hashing would cost more than the
+/// rest of the clustering.
+const DENSE_CELLS: u128 = 1 << 21;
+
 /// [`clusters`] with its working memory kept between calls: the detection
 /// cascade clusters once per round, and fresh multi-megabyte buffers every
 /// round cost more in page faults than the clustering itself.
@@ -81,7 +88,7 @@ impl Clusterer {
             (hi.0 as i128 - lo.0 as i128 + 1) as u128,
             (hi.1 as i128 - lo.1 as i128 + 1) as u128,
         );
-        let dense = gw * gh <= 4 * n as u128 + 65_536;
+        let dense = gw * gh <= 4 * n as u128 + DENSE_CELLS;
         let (gw, gh) = if dense {
             (gw as usize, gh as usize)
         } else {
@@ -209,6 +216,19 @@ impl Clusterer {
                 }
                 let b = &self.items
                     [self.start[nb as usize] as usize..self.start[nb as usize + 1] as usize];
+                // Quick look first: in a dense surface a few points of each
+                // cell usually already include a close pair.
+                let quick = a.iter().take(4).any(|&i| {
+                    let p = points[i as usize];
+                    b.iter()
+                        .take(4)
+                        .any(|&j| (points[j as usize] - p).length_squared() < tol2)
+                });
+                if quick {
+                    let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
+                    parent[hi as usize] = lo;
+                    continue;
+                }
                 near.clear();
                 near.extend(
                     a.iter()

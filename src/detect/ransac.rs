@@ -298,8 +298,9 @@ impl<'a> PlanePool<'a> {
                 };
                 // The least-squares plane beats a three-point plane; keep it
                 // unless it explains clearly fewer points.
-                let again = self.collect_prefix(&refit, lo_k);
-                if 10 * again.len() >= 9 * sample.len() {
+                self.work += lo_k as u64;
+                let again = self.count(&refit, 0, lo_k);
+                if 10 * again >= 9 * sample.len() {
                     plane = refit;
                 }
             }
@@ -474,7 +475,11 @@ impl<'a> PlanePool<'a> {
         let (d, t) = (plane.offset as f32, plane.threshold as f32);
         let mut out = Vec::new();
         let (xs, ys, zs) = (&self.rx[..k], &self.ry[..k], &self.rz[..k]);
-        let (cx, cy, cz) = (xs.chunks_exact(64), ys.chunks_exact(64), zs.chunks_exact(64));
+        let (cx, cy, cz) = (
+            xs.chunks_exact(64),
+            ys.chunks_exact(64),
+            zs.chunks_exact(64),
+        );
         let tail = cx.remainder().len();
         for (c, ((x, y), z)) in cx.zip(cy).zip(cz).enumerate() {
             let mut m = 0u64;
