@@ -495,30 +495,36 @@ fn trace_region(grid: Vec<bool>, w: usize, h: usize, r: usize) -> Option<Traced>
         grid
     };
     // Largest 4-connected region (first found wins ties: row-major order).
+    // The flood fills keep cell coordinates on their stacks: no division per
+    // visited cell.
     let mut label = vec![0u32; w * h];
     let (mut best, mut best_size, mut next) = (0u32, 0usize, 1u32);
-    let mut stack = Vec::new();
-    for start in 0..w * h {
-        if !closed[start] || label[start] != 0 {
-            continue;
-        }
-        let mut size = 0;
-        label[start] = next;
-        stack.push(start);
-        while let Some(k) = stack.pop() {
-            size += 1;
-            for nb in neighbours4(k, w, h) {
-                if closed[nb] && label[nb] == 0 {
-                    label[nb] = next;
-                    stack.push(nb);
-                }
+    let mut stack: Vec<(u32, u32)> = Vec::new();
+    for sy in 0..h {
+        for sx in 0..w {
+            let start = sy * w + sx;
+            if !closed[start] || label[start] != 0 {
+                continue;
             }
+            let mut size = 0;
+            label[start] = next;
+            stack.push((sx as u32, sy as u32));
+            while let Some((x, y)) = stack.pop() {
+                size += 1;
+                for_neighbours4(x, y, w, h, |nx, ny| {
+                    let nb = ny as usize * w + nx as usize;
+                    if closed[nb] && label[nb] == 0 {
+                        label[nb] = next;
+                        stack.push((nx, ny));
+                    }
+                });
+            }
+            if size > best_size {
+                best_size = size;
+                best = next;
+            }
+            next += 1;
         }
-        if size > best_size {
-            best_size = size;
-            best = next;
-        }
-        next += 1;
     }
     if best_size == 0 {
         return None;
@@ -526,19 +532,24 @@ fn trace_region(grid: Vec<bool>, w: usize, h: usize, r: usize) -> Option<Traced>
     // Fill holes: everything not reachable from the border through
     // non-region cells belongs to the region.
     let mut outside = vec![false; w * h];
-    for k in 0..w * h {
-        let (x, y) = (k % w, k / w);
-        if (x == 0 || y == 0 || x == w - 1 || y == h - 1) && label[k] != best && !outside[k] {
-            outside[k] = true;
-            stack.push(k);
-            while let Some(j) = stack.pop() {
-                for nb in neighbours4(j, w, h) {
-                    if label[nb] != best && !outside[nb] {
-                        outside[nb] = true;
-                        stack.push(nb);
-                    }
+    let border = (0..w)
+        .flat_map(|x| [(x, 0), (x, h - 1)])
+        .chain((0..h).flat_map(|y| [(0, y), (w - 1, y)]));
+    for (bx, by) in border {
+        let k = by * w + bx;
+        if label[k] == best || outside[k] {
+            continue;
+        }
+        outside[k] = true;
+        stack.push((bx as u32, by as u32));
+        while let Some((x, y)) = stack.pop() {
+            for_neighbours4(x, y, w, h, |nx, ny| {
+                let nb = ny as usize * w + nx as usize;
+                if label[nb] != best && !outside[nb] {
+                    outside[nb] = true;
+                    stack.push((nx, ny));
                 }
-            }
+            });
         }
     }
     let inside = |x: i64, y: i64| -> bool {
@@ -596,16 +607,20 @@ fn trace_region(grid: Vec<bool>, w: usize, h: usize, r: usize) -> Option<Traced>
     Some((ring, inside_mask))
 }
 
-fn neighbours4(k: usize, w: usize, h: usize) -> impl Iterator<Item = usize> {
-    let (x, y) = (k % w, k / w);
-    [
-        (x > 0).then(|| k - 1),
-        (x + 1 < w).then(|| k + 1),
-        (y > 0).then(|| k - w),
-        (y + 1 < h).then(|| k + w),
-    ]
-    .into_iter()
-    .flatten()
+#[inline]
+fn for_neighbours4(x: u32, y: u32, w: usize, h: usize, mut f: impl FnMut(u32, u32)) {
+    if x > 0 {
+        f(x - 1, y);
+    }
+    if (x as usize) + 1 < w {
+        f(x + 1, y);
+    }
+    if y > 0 {
+        f(x, y - 1);
+    }
+    if (y as usize) + 1 < h {
+        f(x, y + 1);
+    }
 }
 
 /// Cells whose centre lies within `radius` cells of the centre of a set cell
@@ -631,24 +646,38 @@ pub(crate) fn dilate_disk(grid: &[bool], w: usize, h: usize, radius: f64) -> Vec
             out[x] = out[x].min(last);
         }
     }
+    // A cell at row offset dy is within the disk when the row distance is at
+    // most reach[|dy|] (integer: dx^2 + dy^2 <= radius^2).
     let lim = radius * radius;
+    let reach: Vec<u32> = (0..=r)
+        .map(|dy| {
+            let mut dx = r as u32;
+            while dx > 0 && (dx * dx) as f64 + (dy * dy) as f64 > lim {
+                dx -= 1;
+            }
+            if ((dx * dx) as f64 + (dy * dy) as f64) <= lim {
+                dx
+            } else {
+                u32::MAX // not even dx = 0 fits (radius < dy): never hit
+            }
+        })
+        .collect();
+    // Row by row: OR in the rows of the window, a branch-free pass each
+    // (the compiler vectorises it).
     let mut out = vec![false; w * h];
     for y in 0..h {
         let y0 = y.saturating_sub(r);
         let y1 = (y + r).min(h - 1);
-        for x in 0..w {
-            let mut hit = false;
-            for yy in y0..=y1 {
-                let dx = hd[yy * w + x];
-                if dx <= r as u32 {
-                    let dy = yy as f64 - y as f64;
-                    if (dx * dx) as f64 + dy * dy <= lim {
-                        hit = true;
-                        break;
-                    }
-                }
+        let o = &mut out[y * w..(y + 1) * w];
+        for yy in y0..=y1 {
+            let lim = reach[yy.abs_diff(y)];
+            if lim == u32::MAX {
+                continue;
             }
-            out[y * w + x] = hit;
+            let row = &hd[yy * w..(yy + 1) * w];
+            for (b, &d) in o.iter_mut().zip(row) {
+                *b |= d <= lim;
+            }
         }
     }
     out
