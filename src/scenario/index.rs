@@ -31,19 +31,30 @@ impl ScanIndex {
         let inv = 1.0 / voxel;
         let mut map: GridMap<u64, u32> = GridMap::default();
         let mut cell_of = Vec::with_capacity(pts.len());
+        let mut cell_xyz: Vec<[i64; 3]> = Vec::new();
         let (mut lo, mut hi) = ([i64::MAX; 3], [i64::MIN; 3]);
+        // Consecutive points of a scan mostly share a voxel: remember the
+        // last one and skip the map for repeats.
+        let mut last = ([i64::MAX; 3], 0u32);
         for p in pts {
             let c = [
                 crate::hash::floor_i64(p.x as f64 * inv),
                 crate::hash::floor_i64(p.y as f64 * inv),
                 crate::hash::floor_i64(p.z as f64 * inv),
             ];
-            for k in 0..3 {
-                lo[k] = lo[k].min(c[k]);
-                hi[k] = hi[k].max(c[k]);
+            if c != last.0 {
+                let next = map.len() as u32;
+                let id = *map.entry(key3(c[0], c[1], c[2])).or_insert(next);
+                if id == next {
+                    cell_xyz.push(c);
+                    for k in 0..3 {
+                        lo[k] = lo[k].min(c[k]);
+                        hi[k] = hi[k].max(c[k]);
+                    }
+                }
+                last = (c, id);
             }
-            let next = map.len() as u32;
-            cell_of.push(*map.entry(key3(c[0], c[1], c[2])).or_insert(next));
+            cell_of.push(last.1);
         }
         let cells = map.len();
         let mut start = vec![0u32; cells + 1];
@@ -65,12 +76,8 @@ impl ScanIndex {
             if d[0] * d[1] * d[2] <= MAX_DENSE as u128 {
                 dims = d.map(|x| x as usize);
                 occ = vec![0u64; (dims[0] * dims[1] * dims[2]).div_ceil(64)];
-                for p in pts {
-                    let c = [
-                        crate::hash::floor_i64(p.x as f64 * inv) - lo[0],
-                        crate::hash::floor_i64(p.y as f64 * inv) - lo[1],
-                        crate::hash::floor_i64(p.z as f64 * inv) - lo[2],
-                    ];
+                for c in &cell_xyz {
+                    let c = [c[0] - lo[0], c[1] - lo[1], c[2] - lo[2]];
                     let k = (c[2] as usize * dims[1] + c[1] as usize) * dims[0] + c[0] as usize;
                     occ[k >> 6] |= 1 << (k & 63);
                 }
