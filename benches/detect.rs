@@ -55,7 +55,7 @@ fn bench(c: &mut Criterion) {
             "ouster_os1_64_legacy_f12073.bin",
         ] {
             let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-                .join("../shared/data")
+                .join("www/data")
                 .join(file);
             let Ok(values) = polyscene::io::read_bin(&path, 4) else {
                 eprintln!("skipping {file}: not found at {}", path.display());
