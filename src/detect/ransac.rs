@@ -70,9 +70,12 @@ pub struct PlanePool<'a> {
     /// Live points per voxel.
     cell_live: Vec<u32>,
     rng: Rng,
-    /// Points still in play (the arrays may also hold dead ones, as NaN).
+    /// Points still in play.
     live: usize,
-    /// Pool position of each original index (`u32::MAX` once compacted away).
+    /// Of those, how many are in the scoring pool (whose arrays may also
+    /// hold dead ones, as NaN).
+    pool_live: usize,
+    /// Pool position of each original index (`u32::MAX` when not in the pool).
     pos_of: Vec<u32>,
     /// Point-to-plane distance evaluations so far.
     pub work: u64,
@@ -81,6 +84,12 @@ pub struct PlanePool<'a> {
 const START_K: usize = 4096;
 const MIN_RANKABLE: usize = 40;
 const MIN_HYPOTHESES: usize = 24;
+/// Most points in the scoring pool: hypotheses are ranked on prefixes of a
+/// random subset of this size. Planes too small to reach `MIN_RANKABLE`
+/// inliers in it (under 0.015 % of the cloud) are below any sensible
+/// `min_inliers` in clouds of up to ~10^6 points, and building a random
+/// order of a ten-million-point cloud would cost more than detecting in it.
+const POOL_CAP: usize = 1 << 18;
 /// Most points the local optimisation (robust refit) looks at.
 const LO_SAMPLE: usize = 16_384;
 
@@ -88,15 +97,27 @@ impl<'a> PlanePool<'a> {
     /// All of `pts` in play, shuffled once with `rng`.
     pub fn new(pts: &'a [Vec3], sample_radius: f64, mut rng: Rng) -> Self {
         let n = pts.len();
+        // A uniform random subset of at most POOL_CAP points in random order
+        // (the first steps of a Fisher-Yates shuffle): every prefix is a
+        // uniform random subsample, which is all the scoring needs.
+        let m = n.min(POOL_CAP);
         let mut order: Vec<u32> = (0..n as u32).collect();
-        for i in (1..n).rev() {
-            let j = rng.below(i + 1);
-            order.swap(i, j);
+        if n <= POOL_CAP {
+            for i in (1..n).rev() {
+                let j = rng.below(i + 1);
+                order.swap(i, j);
+            }
+        } else {
+            for i in 0..m {
+                let j = i + rng.below(n - i);
+                order.swap(i, j);
+            }
+            order.truncate(m);
         }
         let (mut rx, mut ry, mut rz) = (
-            Vec::with_capacity(n),
-            Vec::with_capacity(n),
-            Vec::with_capacity(n),
+            Vec::with_capacity(m),
+            Vec::with_capacity(m),
+            Vec::with_capacity(m),
         );
         for &i in &order {
             let p = pts[i as usize];
@@ -137,7 +158,7 @@ impl<'a> PlanePool<'a> {
             cell_items[fill[c as usize] as usize] = i as u32;
             fill[c as usize] += 1;
         }
-        let mut pos_of = vec![0u32; n];
+        let mut pos_of = vec![u32::MAX; n];
         for (pos, &i) in order.iter().enumerate() {
             pos_of[i as usize] = pos as u32;
         }
@@ -161,6 +182,7 @@ impl<'a> PlanePool<'a> {
             cell_live.push(members.len() as u32);
         }
         PlanePool {
+            pool_live: m,
             cell_pts,
             cell_pos_of,
             cell_box,
@@ -199,12 +221,16 @@ impl<'a> PlanePool<'a> {
             self.live -= 1;
             self.cell_pts[self.cell_pos_of[i as usize] as usize] = Vec3::NAN;
             self.cell_live[self.cell_of[i as usize] as usize] -= 1;
-            let pos = self.pos_of[i as usize] as usize;
-            self.rx[pos] = f32::NAN;
-            self.ry[pos] = f32::NAN;
-            self.rz[pos] = f32::NAN;
+            let pos = self.pos_of[i as usize];
+            if pos != u32::MAX {
+                let pos = pos as usize;
+                self.rx[pos] = f32::NAN;
+                self.ry[pos] = f32::NAN;
+                self.rz[pos] = f32::NAN;
+                self.pool_live -= 1;
+            }
         }
-        if 2 * self.live >= self.ridx.len() {
+        if 2 * self.pool_live >= self.ridx.len() {
             return;
         }
         let mut w = 0;
