@@ -1,6 +1,7 @@
 //! Per-scan update of the incremental scenario (gpp2, concave, expansion on)
-//! on a simulated HDL-64E street drive: the scenario is warmed up with 30
-//! scans, then each iteration adds the next scan to a clone of it. One
+//! on a simulated HDL-64E drive: the states after scans 0..k are kept for k
+//! in 30..40, and each iteration adds scan k to a clone of the state before
+//! it (consecutive scans, as in a live drive; the clone is not timed). One
 //! thread. `cargo bench --bench scenario`
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
@@ -15,21 +16,25 @@ fn bench(c: &mut Criterion) {
     for layout in [Layout::Street, Layout::Crossing] {
         let drive = Drive::new(layout, 1, SensorModel::default(), DriveOptions::default()).unwrap();
         let mut warm = Scenario::new(Params::gpp2()).unwrap();
-        for k in 0..30 {
+        let mut states = Vec::new();
+        for k in 0..40 {
             let s = drive.scan(k).unwrap();
+            if k >= 30 {
+                states.push((warm.clone(), s.clone()));
+            }
             warm.add_scan(&s.points, 4, &s.pose).unwrap();
         }
-        let next: Vec<_> = (30..40).map(|k| drive.scan(k).unwrap()).collect();
         let mut i = 0;
         g.bench_function(format!("add_scan/{}", layout.as_str()), |b| {
             b.iter_batched(
                 || {
-                    i = (i + 1) % next.len();
-                    (warm.clone(), i)
+                    i = (i + 1) % states.len();
+                    (states[i].0.clone(), i)
                 },
                 |(mut s, i)| {
+                    let scan = &states[i].1;
                     black_box(
-                        s.add_scan(&next[i].points, 4, &next[i].pose)
+                        s.add_scan(&scan.points, 4, &scan.pose)
                             .unwrap()
                             .polygon_count,
                     )
