@@ -433,3 +433,54 @@ fn far_from_the_origin_gives_the_same_polygons_translated() {
         }
     }
 }
+
+#[test]
+fn clouds_beyond_the_scoring_pool_keep_small_planes_and_stay_total() {
+    // 1.5M floor points: RANSAC scores on a random subset of 2^18 of them.
+    // Once the floor is taken, a 2 m x 1 m wall of 200 points and three
+    // stray points are left, few of them (or none) in that subset: the pool
+    // is redrawn from the live points, the wall is found, and nothing panics
+    // even with `min_inliers` at its smallest.
+    let mut rng = Rng::new(21);
+    let mut pts = Vec::with_capacity(1_500_300);
+    for _ in 0..1_500_000 {
+        pts.push(DVec3::new(
+            rng.range(0.0, 50.0),
+            rng.range(0.0, 30.0),
+            rng.range(-0.01, 0.01),
+        ));
+    }
+    for i in 0..20 {
+        for j in 0..10 {
+            pts.push(DVec3::new(
+                80.0,
+                10.0 + i as f64 * 0.1,
+                1.0 + j as f64 * 0.1,
+            ));
+        }
+    }
+    pts.extend([
+        DVec3::new(90.0, 0.0, 5.0),
+        DVec3::new(95.0, 7.0, 9.0),
+        DVec3::new(99.0, 3.0, 2.0),
+    ]);
+    let cloud = cloud(&pts);
+    for min_inliers in [150, 3] {
+        let p = Params {
+            viewpoint: [25.0, 15.0, 2.0],
+            min_inliers,
+            min_area: 1.0,
+            ..Params::gpp2()
+        };
+        let det = detect(&cloud, &p).unwrap();
+        let floor = det.primitives.iter().find(|q| q.ground).expect("the floor");
+        assert!((floor.area - 1500.0).abs() < 30.0, "floor {}", floor.area);
+        let wall = det
+            .primitives
+            .iter()
+            .find(|q| q.plane.normal.x.abs() > 0.99)
+            .unwrap_or_else(|| panic!("min_inliers {min_inliers}: no wall"));
+        assert!(wall.support >= 190, "wall support {}", wall.support);
+        assert!((wall.area - 2.0).abs() < 0.6, "wall area {}", wall.area);
+    }
+}

@@ -208,6 +208,36 @@ impl<'a> PlanePool<'a> {
         self.live
     }
 
+    /// Replace the scoring pool by a fresh random subset (at most
+    /// `POOL_CAP`) of the live points, in random order.
+    fn refill(&mut self) {
+        for &i in &self.ridx {
+            self.pos_of[i as usize] = u32::MAX;
+        }
+        let mut order: Vec<u32> = (0..self.pts.len() as u32)
+            .filter(|&i| self.alive[i as usize])
+            .collect();
+        let n = order.len();
+        let m = n.min(POOL_CAP);
+        for i in 0..m {
+            let j = i + self.rng.below(n - i);
+            order.swap(i, j);
+        }
+        order.truncate(m);
+        self.rx.clear();
+        self.ry.clear();
+        self.rz.clear();
+        for (pos, &i) in order.iter().enumerate() {
+            let p = self.pts[i as usize];
+            self.rx.push(p.x);
+            self.ry.push(p.y);
+            self.rz.push(p.z);
+            self.pos_of[i as usize] = pos as u32;
+        }
+        self.ridx = order;
+        self.pool_live = m;
+    }
+
     /// Take these original indices out of play. Their coordinates in the
     /// pool become NaN, which fails every inlier test, so no pass over the
     /// pool needs to check liveness; the arrays are compacted only once half
@@ -262,6 +292,15 @@ impl<'a> PlanePool<'a> {
         viewpoint: DVec3,
     ) -> Option<(LocalPlane, Vec<u32>)> {
         if self.remaining() < params.min_inliers.max(3) {
+            return None;
+        }
+        // A scoring subset of a big cloud thins out as planes leave; draw a
+        // fresh one from the live points once it holds under a quarter of
+        // what it could.
+        if 4 * self.pool_live < self.live.min(POOL_CAP) {
+            self.refill();
+        }
+        if self.ridx.is_empty() {
             return None;
         }
         // Prefixes run over the pool arrays, dead (NaN) entries included.
@@ -365,6 +404,9 @@ impl<'a> PlanePool<'a> {
     /// `None` when degenerate.
     fn sample(&mut self) -> Option<(DVec3, f64, usize)> {
         let n = self.ridx.len();
+        if n == 0 {
+            return None;
+        }
         let mut i1 = self.ridx[self.rng.below(n)];
         for _ in 0..8 {
             if self.alive[i1 as usize] {
