@@ -306,10 +306,10 @@ pub(crate) fn shape(
     };
     let mut footprint = Footprint::new(cell);
     footprint.mark_all(&q_near);
-    let (outline, kept) = match params.hull {
+    let (outline, kept, region) = match params.hull {
         HullKind::Convex => {
             let h = cap_convex(convex_hull(&q_near)?, params);
-            (h, near)
+            (h, near, None)
         }
         HullKind::Concave => {
             let (ring, region) =
@@ -319,19 +319,26 @@ pub(crate) fn shape(
                 .zip(&near)
                 .map(|(&p, &k)| k && region.contains(p))
                 .collect();
-            (ring, kept)
+            (ring, kept, Some(region))
         }
     };
     let support = kept.iter().filter(|&&k| k).count() as u64;
     if kept.iter().any(|k| !k) {
-        moments = moments_of(&|i| kept[i] && inner[i]);
-        footprint = Footprint::new(cell);
-        let q_kept: Vec<DVec2> = q
-            .iter()
-            .zip(&kept)
-            .filter_map(|(&p, &k)| k.then_some(p))
-            .collect();
-        footprint.mark_all(&q_kept);
+        // Keep the statistics of the kept points only: take the dropped
+        // ones out of the moments (fewer than the kept), and the footprint
+        // cells outside the region (a kept point's cell is exactly a marked
+        // cell inside it; with a convex hull every point near the plane is
+        // kept, so its footprint is already right).
+        let mut dropped = Moments::new(moments.reference);
+        for (i, p) in pts.iter().enumerate() {
+            if inner[i] && !kept[i] {
+                dropped.push(origin + p.as_dvec3());
+            }
+        }
+        moments.remove(&dropped);
+        if let Some(region) = &region {
+            footprint.retain_region(region);
+        }
     }
     let area = signed_area(&outline);
     if area.is_nan() || area <= 0.0 {

@@ -294,6 +294,22 @@ impl Footprint {
         fresh
     }
 
+    /// Clear the set cells outside `region` (traced from this footprint):
+    /// afterwards the footprint holds exactly the cells of the points the
+    /// region contains.
+    pub fn retain_region(&mut self, region: &Region) {
+        for y in 0..self.h {
+            for x in 0..self.w {
+                if self.get_local(x, y)
+                    && !region.contains(self.centre(self.x0 + x as i64, self.y0 + y as i64))
+                {
+                    let k = y * self.w + x;
+                    self.bits[k >> 6] &= !(1 << (k & 63));
+                }
+            }
+        }
+    }
+
     /// Number of set cells.
     pub fn count(&self) -> usize {
         self.bits.iter().map(|b| b.count_ones() as usize).sum()

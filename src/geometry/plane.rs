@@ -205,6 +205,18 @@ impl Moments {
         self.count += n;
     }
 
+    /// Take out the moments of a subset of the points these were summed
+    /// from, with the same reference point (cheaper than summing the rest
+    /// again when the subset is small).
+    pub fn remove(&mut self, subset: &Moments) {
+        debug_assert_eq!(self.reference, subset.reference);
+        self.count -= subset.count;
+        self.sum -= subset.sum;
+        for (a, b) in self.sum_sq.iter_mut().zip(&subset.sum_sq) {
+            *a -= b;
+        }
+    }
+
     /// Mean of the points (world).
     pub fn mean(&self) -> DVec3 {
         if self.count == 0.0 {
