@@ -32,6 +32,7 @@ impl ScanIndex {
         let mut map: GridMap<u64, u32> = GridMap::default();
         let mut cell_of = Vec::with_capacity(pts.len());
         let mut cell_xyz: Vec<[i64; 3]> = Vec::new();
+        let mut aliased: Vec<[i64; 3]> = Vec::new();
         let (mut lo, mut hi) = ([i64::MAX; 3], [i64::MIN; 3]);
         // Consecutive points of a scan mostly share a voxel: remember the
         // last one and skip the map for repeats.
@@ -45,8 +46,15 @@ impl ScanIndex {
             if c != last.0 {
                 let next = map.len() as u32;
                 let id = *map.entry(key3(c[0], c[1], c[2])).or_insert(next);
-                if id == next {
-                    cell_xyz.push(c);
+                // A new voxel, or one whose packed key wraps onto another's
+                // (coordinates 2^21 voxels apart): both count for the box
+                // and the occupancy bits.
+                if id == next || cell_xyz[id as usize] != c {
+                    if id == next {
+                        cell_xyz.push(c);
+                    } else {
+                        aliased.push(c);
+                    }
                     for k in 0..3 {
                         lo[k] = lo[k].min(c[k]);
                         hi[k] = hi[k].max(c[k]);
@@ -76,7 +84,7 @@ impl ScanIndex {
             if d[0] * d[1] * d[2] <= MAX_DENSE as u128 {
                 dims = d.map(|x| x as usize);
                 occ = vec![0u64; (dims[0] * dims[1] * dims[2]).div_ceil(64)];
-                for c in &cell_xyz {
+                for c in cell_xyz.iter().chain(&aliased) {
                     let c = [c[0] - lo[0], c[1] - lo[1], c[2] - lo[2]];
                     let k = (c[2] as usize * dims[1] + c[1] as usize) * dims[0] + c[0] as usize;
                     occ[k >> 6] |= 1 << (k & 63);
@@ -185,5 +193,32 @@ impl ScanIndex {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn voxels_whose_keys_wrap_are_still_found() {
+        // 2^21 voxels apart, the packed keys of (0, 0, 0) and (2^21, 0, 0)
+        // coincide: the far voxel must still be in the index's box and
+        // occupancy, and visiting it yields its point.
+        let far = (1u64 << 21) as f32;
+        let pts = vec![Vec3::new(0.5, 0.5, 0.5), Vec3::new(far + 0.5, 0.5, 0.5)];
+        let mut index = ScanIndex::new(&pts, 1.0);
+        let mut seen = Vec::new();
+        let x = far as f64 + 0.5;
+        index.for_each_near_plane(
+            1,
+            DVec3::new(x - 1.0, -1.0, -1.0),
+            DVec3::new(x + 1.0, 2.0, 2.0),
+            DVec3::X,
+            -x,
+            0.1,
+            |items| seen.extend_from_slice(items),
+        );
+        assert!(seen.contains(&1), "{seen:?}");
     }
 }
