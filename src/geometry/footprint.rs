@@ -500,6 +500,9 @@ fn inset_rectilinear(ring: &[DVec2], d: f64) -> Vec<DVec2> {
 type Traced = (Vec<(i64, i64)>, Vec<bool>);
 
 fn trace_region(grid: Vec<bool>, w: usize, h: usize, r: usize) -> Option<Traced> {
+    if w == 0 || h == 0 || grid.len() != w * h {
+        return None;
+    }
     let closed = if r > 0 {
         let dil = dilate_disk(&grid, w, h, r as f64);
         let outside: Vec<bool> = dil.iter().map(|&b| !b).collect();
