@@ -1,6 +1,6 @@
 //! One-shot detection (gpp1, gpp2) on a simulated HDL-64E street scan
 //! (~120k points), a simulated location (10 scans, ~1.2M points) and the
-//! real Ouster scans in ../shared/data when present. One thread.
+//! real Ouster scans bundled in www/data. One thread.
 //! `cargo bench --bench detect`
 
 use criterion::{criterion_group, criterion_main, Criterion};

@@ -5,6 +5,27 @@ use polyscene::detect::detect;
 use polyscene::params::Params;
 use polyscene::sim::{Drive, DriveOptions, Layout, SensorModel};
 
+/// Detect `runs` times from `viewpoint`; print the median time with the
+/// polygon and round counts of that run.
+fn time(label: &str, cloud: &Cloud, viewpoint: glam::DVec3, runs: usize) {
+    let p = Params {
+        viewpoint: viewpoint.to_array(),
+        ..Params::gpp2()
+    };
+    let mut t: Vec<_> = (0..runs)
+        .map(|_| {
+            let d = detect(cloud, &p).unwrap();
+            (d.time_ms, d.primitives.len(), d.steps.len())
+        })
+        .collect();
+    t.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (ms, polygons, rounds) = t[runs / 2];
+    println!(
+        "{label} {} pts: median {ms:.1} ms, {polygons} polygons, {rounds} rounds",
+        cloud.len()
+    );
+}
+
 fn main() {
     let drive = Drive::new(
         Layout::Street,
@@ -15,23 +36,7 @@ fn main() {
     .unwrap();
     let scan = drive.scan(20).unwrap();
     let cloud = Cloud::from_world_f64(&scan.world_points()).unwrap();
-    let p = Params {
-        viewpoint: scan.pose.w_axis.truncate().to_array(),
-        ..Params::gpp2()
-    };
-    let mut t = vec![];
-    for _ in 0..7 {
-        let d = detect(&cloud, &p).unwrap();
-        t.push((d.time_ms, d.primitives.len(), d.steps.len()));
-    }
-    t.sort_by(|a, b| a.0.total_cmp(&b.0));
-    println!(
-        "scan  {} pts: median {:.1} ms, {} polygons, {} rounds",
-        cloud.len(),
-        t[3].0,
-        t[3].1,
-        t[3].2
-    );
+    time("scan ", &cloud, scan.pose.w_axis.truncate(), 7);
     let loc = drive.location(20, 10).unwrap();
     let cloud = Cloud::from_world_f64(&loc.points).unwrap();
     let mean = loc
@@ -40,21 +45,5 @@ fn main() {
         .map(|p| p.w_axis.truncate())
         .sum::<glam::DVec3>()
         / loc.poses.len() as f64;
-    let p = Params {
-        viewpoint: mean.to_array(),
-        ..Params::gpp2()
-    };
-    let mut t = vec![];
-    for _ in 0..3 {
-        let d = detect(&cloud, &p).unwrap();
-        t.push((d.time_ms, d.primitives.len(), d.steps.len()));
-    }
-    t.sort_by(|a, b| a.0.total_cmp(&b.0));
-    println!(
-        "location {} pts: median {:.1} ms, {} polygons, {} rounds",
-        cloud.len(),
-        t[1].0,
-        t[1].1,
-        t[1].2
-    );
+    time("location", &cloud, mean, 3);
 }

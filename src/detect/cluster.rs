@@ -7,7 +7,7 @@
 //! than `tol`; only cells whose boxes are closer than `tol` are compared (a
 //! 5x5 neighbourhood), and the comparison stops at the first close pair.
 
-use crate::hash::{floor_i64, key2, GridMap};
+use crate::hash::{floor_i64, key2, Buckets, GridMap};
 use glam::DVec2;
 
 /// Indices of the points in the largest cluster (ties: the cluster holding
@@ -51,9 +51,7 @@ pub struct Clusterer {
     map: GridMap<u64, u32>,
     cell_key: Vec<(i64, i64)>,
     cell_of: Vec<u32>,
-    start: Vec<u32>,
-    fill: Vec<u32>,
-    items: Vec<u32>,
+    buckets: Buckets,
     bbox: Vec<[f64; 4]>,
     near: Vec<DVec2>,
     parent: Vec<u32>,
@@ -132,9 +130,8 @@ impl Clusterer {
             }
         };
         let cells = self.cell_key.len();
-        // CSR of points per cell, and each cell's bounding box.
-        self.start.clear();
-        self.start.resize(cells + 1, 0);
+        // Points per cell, and each cell's bounding box.
+        self.buckets.fill(&self.cell_of, cells);
         self.bbox.clear();
         self.bbox.resize(
             cells,
@@ -146,23 +143,11 @@ impl Clusterer {
             ],
         );
         for (p, &c) in points.iter().zip(&self.cell_of) {
-            self.start[c as usize + 1] += 1;
             let b = &mut self.bbox[c as usize];
             b[0] = b[0].min(p.x);
             b[1] = b[1].min(p.y);
             b[2] = b[2].max(p.x);
             b[3] = b[3].max(p.y);
-        }
-        for i in 0..cells {
-            self.start[i + 1] += self.start[i];
-        }
-        self.fill.clear();
-        self.fill.extend_from_slice(&self.start[..cells]);
-        self.items.clear();
-        self.items.resize(n, 0);
-        for (i, &c) in self.cell_of.iter().enumerate() {
-            self.items[self.fill[c as usize] as usize] = i as u32;
-            self.fill[c as usize] += 1;
         }
         // Half neighbourhood (each unordered pair once) whose boxes are < tol apart.
         let mut offsets = Vec::new();
@@ -194,7 +179,7 @@ impl Clusterer {
         let (parent, near) = (&mut self.parent, &mut self.near);
         for c in 0..cells {
             let (cx, cy) = self.cell_key[c];
-            let a = &self.items[self.start[c] as usize..self.start[c + 1] as usize];
+            let a = self.buckets.of(c);
             for &(dx, dy) in &offsets {
                 let Some(nb) = lookup(
                     &self.ids,
@@ -214,8 +199,7 @@ impl Clusterer {
                 if gx * gx + gy * gy >= tol2 {
                     continue;
                 }
-                let b = &self.items
-                    [self.start[nb as usize] as usize..self.start[nb as usize + 1] as usize];
+                let b = self.buckets.of(nb as usize);
                 // Quick look first: in a dense surface a few points of each
                 // cell usually already include a close pair.
                 let quick = a.iter().take(4).any(|&i| {

@@ -32,7 +32,7 @@
 //! counted in `work` so the cascade can enforce `Params::max_work`.
 
 use crate::geometry::Moments;
-use crate::hash::{key3, GridMap};
+use crate::hash::Buckets;
 use crate::params::Params;
 use crate::rng::Rng;
 use glam::{DVec3, Vec3};
@@ -58,12 +58,12 @@ pub struct PlanePool<'a> {
     rz: Vec<f32>,
     ridx: Vec<u32>,
     cell_of: Vec<u32>,
-    cell_start: Vec<u32>,
-    cell_items: Vec<u32>,
-    /// Coordinates in `cell_items` order (NaN once dead): the full inlier
+    /// Original indices grouped by voxel.
+    voxels: Buckets,
+    /// Coordinates in `voxels.items` order (NaN once dead): the full inlier
     /// collection reads only the voxels a plane's slab crosses.
     cell_pts: Vec<Vec3>,
-    /// Position of each original index in `cell_items`.
+    /// Position of each original index in `voxels.items`.
     cell_pos_of: Vec<u32>,
     /// Bounding box of each voxel's points (centre, half extent), f64.
     cell_box: Vec<(DVec3, DVec3)>,
@@ -126,45 +126,17 @@ impl<'a> PlanePool<'a> {
             rz.push(p.z);
         }
         // Sampling voxels (ids in first-seen order of the original indices).
-        let inv = 1.0 / sample_radius.max(1e-3);
-        let mut map: GridMap<u64, u32> = GridMap::default();
-        let mut cell_of = Vec::with_capacity(n);
-        // Consecutive points of a scan are mostly neighbours along a ring, in
-        // one voxel: remember the last key and skip the map for repeats.
-        let mut last = (u64::MAX, 0u32);
-        for p in pts {
-            let k = key3(
-                crate::hash::floor_i64(p.x as f64 * inv),
-                crate::hash::floor_i64(p.y as f64 * inv),
-                crate::hash::floor_i64(p.z as f64 * inv),
-            );
-            if k != last.0 {
-                let next = map.len() as u32;
-                last = (k, *map.entry(k).or_insert(next));
-            }
-            cell_of.push(last.1);
-        }
-        let cells = map.len();
-        let mut cell_start = vec![0u32; cells + 1];
-        for &c in &cell_of {
-            cell_start[c as usize + 1] += 1;
-        }
-        for i in 0..cells {
-            cell_start[i + 1] += cell_start[i];
-        }
-        let mut fill = cell_start.clone();
-        let mut cell_items = vec![0u32; n];
-        for (i, &c) in cell_of.iter().enumerate() {
-            cell_items[fill[c as usize] as usize] = i as u32;
-            fill[c as usize] += 1;
-        }
+        let voxels = crate::hash::voxelise(pts, sample_radius.max(1e-3));
+        let cells = voxels.coords.len();
+        let cell_of = voxels.cell_of;
+        let buckets = Buckets::new(&cell_of, cells);
         let mut pos_of = vec![u32::MAX; n];
         for (pos, &i) in order.iter().enumerate() {
             pos_of[i as usize] = pos as u32;
         }
-        let cell_pts: Vec<Vec3> = cell_items.iter().map(|&i| pts[i as usize]).collect();
+        let cell_pts: Vec<Vec3> = buckets.items.iter().map(|&i| pts[i as usize]).collect();
         let mut cell_pos_of = vec![0u32; n];
-        for (pos, &i) in cell_items.iter().enumerate() {
+        for (pos, &i) in buckets.items.iter().enumerate() {
             cell_pos_of[i as usize] = pos as u32;
         }
         // Boxes from the points themselves, not from the voxel keys (keys
@@ -172,7 +144,7 @@ impl<'a> PlanePool<'a> {
         let mut cell_box = Vec::with_capacity(cells);
         let mut cell_live = Vec::with_capacity(cells);
         for c in 0..cells {
-            let members = &cell_pts[cell_start[c] as usize..cell_start[c + 1] as usize];
+            let members = &cell_pts[buckets.range(c)];
             let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
             for p in members {
                 lo = lo.min(p.as_dvec3());
@@ -196,8 +168,7 @@ impl<'a> PlanePool<'a> {
             rz,
             ridx: order,
             cell_of,
-            cell_start,
-            cell_items,
+            voxels: buckets,
             rng,
             work: 0,
         }
@@ -381,8 +352,7 @@ impl<'a> PlanePool<'a> {
     /// Judged on at most 64 of its members (an even stride): near the sensor
     /// a voxel holds thousands of points, and an estimate is all this needs.
     fn locally_planar(&mut self, plane: &LocalPlane, cell: usize) -> bool {
-        let members =
-            &self.cell_items[self.cell_start[cell] as usize..self.cell_start[cell + 1] as usize];
+        let members = self.voxels.of(cell);
         let step = members.len().div_ceil(64).max(1);
         let (n, d, t) = (
             plane.normal.as_vec3(),
@@ -418,8 +388,7 @@ impl<'a> PlanePool<'a> {
             return None;
         }
         let c = self.cell_of[i1 as usize] as usize;
-        let members =
-            &self.cell_items[self.cell_start[c] as usize..self.cell_start[c + 1] as usize];
+        let members = self.voxels.of(c);
         let pick = |rng: &mut Rng, not: &[u32]| -> u32 {
             for _ in 0..6 {
                 let j = members[rng.below(members.len())];
@@ -518,12 +487,15 @@ impl<'a> PlanePool<'a> {
             if (plane.normal.dot(centre) + plane.offset).abs() > reach {
                 continue;
             }
-            let (lo, hi) = (self.cell_start[c] as usize, self.cell_start[c + 1] as usize);
+            let (lo, hi) = (
+                self.voxels.start[c] as usize,
+                self.voxels.start[c + 1] as usize,
+            );
             self.work += (hi - lo) as u64;
             for (k, p) in self.cell_pts[lo..hi].iter().enumerate() {
                 let v = nx * p.x + ny * p.y + nz * p.z + d;
                 if v.abs() < t {
-                    out.push(self.cell_items[lo + k]);
+                    out.push(self.voxels.items[lo + k]);
                 }
             }
         }

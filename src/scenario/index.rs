@@ -3,7 +3,7 @@
 //! voxels its grown bounding box crosses near its plane, never to the whole
 //! scan.
 
-use crate::hash::{key3, GridMap};
+use crate::hash::{key3, Buckets, GridMap};
 use glam::{DVec3, Vec3};
 
 /// Points of a scan bucketed by cubic voxels.
@@ -12,8 +12,7 @@ pub struct ScanIndex {
     /// Per voxel: the last visit stamp (see `for_each_near_plane`).
     visited: Vec<u32>,
     map: GridMap<u64, u32>,
-    start: Vec<u32>,
-    items: Vec<u32>,
+    buckets: Buckets,
     lo: [i64; 3],
     hi: [i64; 3],
     /// Dense occupancy bits over the voxel box `lo..=hi` (when it has at
@@ -28,55 +27,17 @@ const MAX_DENSE: usize = 1 << 24;
 impl ScanIndex {
     /// Index `pts` (local coordinates) with voxels of side `voxel` metres.
     pub fn new(pts: &[Vec3], voxel: f64) -> Self {
-        let inv = 1.0 / voxel;
-        let mut map: GridMap<u64, u32> = GridMap::default();
-        let mut cell_of = Vec::with_capacity(pts.len());
-        let mut cell_xyz: Vec<[i64; 3]> = Vec::new();
-        let mut aliased: Vec<[i64; 3]> = Vec::new();
+        let v = crate::hash::voxelise(pts, voxel);
+        let cells = v.coords.len();
+        let buckets = Buckets::new(&v.cell_of, cells);
+        // The box counts every voxel, also those whose packed key wraps onto
+        // another's (coordinates 2^21 voxels apart).
         let (mut lo, mut hi) = ([i64::MAX; 3], [i64::MIN; 3]);
-        // Consecutive points of a scan mostly share a voxel: remember the
-        // last one and skip the map for repeats.
-        let mut last = ([i64::MAX; 3], 0u32);
-        for p in pts {
-            let c = [
-                crate::hash::floor_i64(p.x as f64 * inv),
-                crate::hash::floor_i64(p.y as f64 * inv),
-                crate::hash::floor_i64(p.z as f64 * inv),
-            ];
-            if c != last.0 {
-                let next = map.len() as u32;
-                let id = *map.entry(key3(c[0], c[1], c[2])).or_insert(next);
-                // A new voxel, or one whose packed key wraps onto another's
-                // (coordinates 2^21 voxels apart): both count for the box
-                // and the occupancy bits.
-                if id == next || cell_xyz[id as usize] != c {
-                    if id == next {
-                        cell_xyz.push(c);
-                    } else {
-                        aliased.push(c);
-                    }
-                    for k in 0..3 {
-                        lo[k] = lo[k].min(c[k]);
-                        hi[k] = hi[k].max(c[k]);
-                    }
-                }
-                last = (c, id);
+        for c in v.coords.iter().chain(&v.aliased) {
+            for k in 0..3 {
+                lo[k] = lo[k].min(c[k]);
+                hi[k] = hi[k].max(c[k]);
             }
-            cell_of.push(last.1);
-        }
-        let cells = map.len();
-        let mut start = vec![0u32; cells + 1];
-        for &c in &cell_of {
-            start[c as usize + 1] += 1;
-        }
-        for i in 0..cells {
-            start[i + 1] += start[i];
-        }
-        let mut fill = start.clone();
-        let mut items = vec![0u32; pts.len()];
-        for (i, &c) in cell_of.iter().enumerate() {
-            items[fill[c as usize] as usize] = i as u32;
-            fill[c as usize] += 1;
         }
         let (mut occ, mut dims) = (Vec::new(), [0usize; 3]);
         if !pts.is_empty() {
@@ -84,7 +45,7 @@ impl ScanIndex {
             if d[0] * d[1] * d[2] <= MAX_DENSE as u128 {
                 dims = d.map(|x| x as usize);
                 occ = vec![0u64; (dims[0] * dims[1] * dims[2]).div_ceil(64)];
-                for c in cell_xyz.iter().chain(&aliased) {
+                for c in v.coords.iter().chain(&v.aliased) {
                     let c = [c[0] - lo[0], c[1] - lo[1], c[2] - lo[2]];
                     let k = (c[2] as usize * dims[1] + c[1] as usize) * dims[0] + c[0] as usize;
                     occ[k >> 6] |= 1 << (k & 63);
@@ -94,9 +55,8 @@ impl ScanIndex {
         ScanIndex {
             voxel,
             visited: vec![0; cells],
-            map,
-            start,
-            items,
+            map: v.map,
+            buckets,
             lo,
             hi,
             occ,
@@ -186,9 +146,7 @@ impl ScanIndex {
                             continue;
                         }
                         self.visited[cell as usize] = stamp;
-                        let s = self.start[cell as usize] as usize;
-                        let e = self.start[cell as usize + 1] as usize;
-                        f(&self.items[s..e]);
+                        f(self.buckets.of(cell as usize));
                     }
                 }
             }
