@@ -104,7 +104,12 @@ pub fn segments_intersect(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> bool {
 }
 
 /// Is the ring a simple polygon: at least three distinct vertices, non-zero
-/// area, and no two non-adjacent edges touching? O(n^2); rings here are short.
+/// area, no edge folding back onto its neighbour, and no two non-adjacent
+/// edges touching? Short rings compare every pair of edges; long ones (a
+/// traced road outline has thousands of vertices) only the pairs sharing a
+/// cell of a uniform grid over the ring's box, about linear time for the
+/// axis-aligned rings the outline tracer makes. Both give the same answer:
+/// two touching edges share their touching point, and so its cell.
 pub fn is_simple(ring: &[DVec2]) -> bool {
     let n = ring.len();
     if n < 3 || signed_area(ring).abs() <= 0.0 {
@@ -114,27 +119,103 @@ pub fn is_simple(ring: &[DVec2]) -> bool {
         return false;
     }
     for i in 0..n {
-        let (a, b) = (ring[i], ring[(i + 1) % n]);
-        if a == b {
+        let (prev, cur, next) = (ring[(i + n - 1) % n], ring[i], ring[(i + 1) % n]);
+        if cur == next {
             return false;
         }
-        for j in (i + 1)..n {
-            let adjacent = j == i + 1 || (i == 0 && j == n - 1);
-            let (c, d) = (ring[j], ring[(j + 1) % n]);
-            if adjacent {
-                // Adjacent edges share one vertex; they must not fold back.
-                let (shared, p, q) = if j == i + 1 { (b, a, d) } else { (a, b, c) };
-                if orient(p, shared, q) == 0.0 && (p - shared).dot(q - shared) > 0.0 {
-                    return false;
-                }
-                continue;
-            }
-            if segments_intersect(a, b, c, d) {
-                return false;
+        // Adjacent edges share one vertex; they must not fold back.
+        if orient(prev, cur, next) == 0.0 && (prev - cur).dot(next - cur) > 0.0 {
+            return false;
+        }
+    }
+    // Non-adjacent pairs: (i, j) with i + 1 < j, except the first and last
+    // edge, which share vertex 0.
+    let crossing = |i: usize, j: usize| {
+        let (i, j) = (i.min(j), i.max(j));
+        j > i + 1
+            && !(i == 0 && j == n - 1)
+            && segments_intersect(ring[i], ring[i + 1], ring[j], ring[(j + 1) % n])
+    };
+    if n <= 32 {
+        return !(0..n).any(|i| (i + 2..n).any(|j| crossing(i, j)));
+    }
+    match edges_by_cell(ring) {
+        Some((start, edges)) => !start.windows(2).any(|w| {
+            let cell = &edges[w[0] as usize..w[1] as usize];
+            cell.iter().enumerate().any(|(a, &i)| {
+                cell[a + 1..]
+                    .iter()
+                    .any(|&j| crossing(i as usize, j as usize))
+            })
+        }),
+        None => !(0..n).any(|i| (i + 2..n).any(|j| crossing(i, j))),
+    }
+}
+
+/// The ring's edges bucketed by the cells of a grid of about `n` cells over
+/// its box (edge `i` in every cell its box overlaps): cell `c` holds
+/// `edges[start[c]..start[c + 1]]`. `None` when the edges' boxes cover too
+/// many cells (long diagonal edges), where comparing all pairs is cheaper.
+fn edges_by_cell(ring: &[DVec2]) -> Option<(Vec<u32>, Vec<u32>)> {
+    let n = ring.len();
+    let (mut lo, mut hi) = (ring[0], ring[0]);
+    for &p in ring {
+        lo = lo.min(p);
+        hi = hi.max(p);
+    }
+    let g = ((n as f64).sqrt().ceil() as usize).max(1);
+    let size = (hi - lo) / g as f64;
+    // Monotone in the coordinate, so a point on two edges' boxes maps to a
+    // cell inside both edges' cell ranges.
+    let index = |v: f64, lo: f64, size: f64| -> usize {
+        if size > 0.0 {
+            (((v - lo) / size) as usize).min(g - 1)
+        } else {
+            0
+        }
+    };
+    let range = |i: usize| {
+        let (a, b) = (ring[i], ring[(i + 1) % n]);
+        let (x0, x1) = (
+            index(a.x.min(b.x), lo.x, size.x),
+            index(a.x.max(b.x), lo.x, size.x),
+        );
+        let (y0, y1) = (
+            index(a.y.min(b.y), lo.y, size.y),
+            index(a.y.max(b.y), lo.y, size.y),
+        );
+        (x0, x1, y0, y1)
+    };
+    let mut count = vec![0u32; g * g + 1];
+    let mut total = 0usize;
+    for i in 0..n {
+        let (x0, x1, y0, y1) = range(i);
+        total += (x1 - x0 + 1) * (y1 - y0 + 1);
+        if total > 16 * n {
+            return None;
+        }
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                count[y * g + x + 1] += 1;
             }
         }
     }
-    true
+    for c in 1..count.len() {
+        count[c] += count[c - 1];
+    }
+    let start = count.clone();
+    let mut edges = vec![0u32; total];
+    for i in 0..n {
+        let (x0, x1, y0, y1) = range(i);
+        for y in y0..=y1 {
+            for x in x0..=x1 {
+                let c = &mut count[y * g + x];
+                edges[*c as usize] = i as u32;
+                *c += 1;
+            }
+        }
+    }
+    Some((start, edges))
 }
 
 /// Make the ring counter-clockwise (reversing it if needed).
@@ -351,6 +432,120 @@ impl Polygon3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every pair of edges: the reference the bucketed test must agree with.
+    fn is_simple_brute_force(ring: &[DVec2]) -> bool {
+        let n = ring.len();
+        if n < 3 || signed_area(ring).abs() <= 0.0 || ring.iter().any(|p| !p.is_finite()) {
+            return false;
+        }
+        for i in 0..n {
+            let (a, b) = (ring[i], ring[(i + 1) % n]);
+            if a == b {
+                return false;
+            }
+            for j in (i + 1)..n {
+                let (c, d) = (ring[j], ring[(j + 1) % n]);
+                if j == i + 1 || (i == 0 && j == n - 1) {
+                    let (shared, p, q) = if j == i + 1 { (b, a, d) } else { (a, b, c) };
+                    if orient(p, shared, q) == 0.0 && (p - shared).dot(q - shared) > 0.0 {
+                        return false;
+                    }
+                } else if segments_intersect(a, b, c, d) {
+                    return false;
+                }
+            }
+        }
+        true
+    }
+
+    #[test]
+    fn bucketed_simplicity_test_agrees_with_all_pairs() {
+        let mut rng = crate::rng::Rng::new(5);
+        let (mut simple, mut not) = (0, 0);
+        for case in 0..400 {
+            let n = 33 + rng.below(200);
+            let ring: Vec<DVec2> = match case % 5 {
+                // A comb: one long bottom edge, teeth on top; sometimes one
+                // tooth reaches down to touch the long edge far from its
+                // ends (the case a bucketing bug would miss).
+                4 => {
+                    let m = n / 4;
+                    let deep = rng.below(2) == 0;
+                    let hit = 1 + rng.below(m - 2);
+                    let mut r = vec![DVec2::new(0.0, 0.0), DVec2::new(2.0 * m as f64, 0.0)];
+                    for k in (0..m).rev() {
+                        let x = 2.0 * k as f64;
+                        let low = if deep && k == hit { 0.0 } else { 1.0 };
+                        r.push(DVec2::new(x + 2.0, 3.0));
+                        r.push(DVec2::new(x + 1.5, 3.0));
+                        r.push(DVec2::new(x + 1.5, low));
+                        r.push(DVec2::new(x + 0.5, low));
+                        r.push(DVec2::new(x + 0.5, 3.0));
+                    }
+                    r.push(DVec2::new(0.0, 3.0));
+                    r.dedup();
+                    r
+                }
+                // Star-shaped around the origin: simple unless radii repeat.
+                0 => (0..n)
+                    .map(|k| {
+                        let t = k as f64 / n as f64 * std::f64::consts::TAU;
+                        let r = 1.0 + rng.below(100) as f64 / 50.0;
+                        DVec2::new(r * t.cos(), r * t.sin())
+                    })
+                    .collect(),
+                // Random walk on a coarse lattice: axis-aligned edges that
+                // often touch or overlap (pinches, back-tracks).
+                1 => {
+                    let mut p = DVec2::ZERO;
+                    (0..n)
+                        .map(|_| {
+                            let q = p;
+                            let step = (1 + rng.below(3)) as f64;
+                            match rng.below(4) {
+                                0 => p.x += step,
+                                1 => p.y += step,
+                                2 => p.x -= step,
+                                _ => p.y -= step,
+                            }
+                            q
+                        })
+                        .collect()
+                }
+                // A staircase (simple), sometimes with one vertex moved onto
+                // another edge.
+                2 => {
+                    let m = n / 2;
+                    let mut r: Vec<DVec2> = (0..m)
+                        .flat_map(|k| {
+                            let k = k as f64;
+                            [DVec2::new(k, k), DVec2::new(k + 1.0, k)]
+                        })
+                        .collect();
+                    r.push(DVec2::new(m as f64, m as f64 + 5.0));
+                    r.push(DVec2::new(-1.0, m as f64 + 5.0));
+                    if rng.below(2) == 0 {
+                        let k = 2 * rng.below(m - 2) + 2;
+                        r[k] = DVec2::new(r[k].x - 1.0, r[k].y);
+                    }
+                    r
+                }
+                // Uniform random points: almost never simple.
+                _ => (0..n)
+                    .map(|_| DVec2::new(rng.below(1000) as f64, rng.below(1000) as f64))
+                    .collect(),
+            };
+            let expected = is_simple_brute_force(&ring);
+            assert_eq!(is_simple(&ring), expected, "case {case}: {ring:?}");
+            if expected {
+                simple += 1;
+            } else {
+                not += 1;
+            }
+        }
+        assert!(simple > 100 && not > 100, "{simple} simple, {not} not");
+    }
 
     fn square(s: f64) -> Vec<DVec2> {
         vec![
