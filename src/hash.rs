@@ -148,48 +148,181 @@ pub struct Voxels {
     /// Integer coordinates of each voxel id.
     pub coords: Vec<[i64; 3]>,
     /// Further voxels whose packed key ([`key3`]) wraps onto an earlier
-    /// voxel's (coordinates 2^21 voxels apart): they share its id.
+    /// voxel's (coordinates 2^21 voxels apart): they share its id. Only
+    /// with [`VoxelIds::Map`].
     pub aliased: Vec<[i64; 3]>,
-    /// Packed key to voxel id.
-    pub map: GridMap<u64, u32>,
+    /// Voxel coordinates to id.
+    pub ids: VoxelIds,
 }
 
-/// Assign `pts` to voxels of side `voxel`. Consecutive points of a scan
-/// are mostly neighbours along a ring, in one voxel: the last voxel is
-/// remembered and the map skipped for repeats.
+/// Voxel coordinates to voxel id: a dense array over the voxels' bounding
+/// box when that is small enough (a street scan at 1 m: ~10^5 to 10^6
+/// voxels), else a hash map of packed keys.
+pub enum VoxelIds {
+    /// `ids[linear index in the box] = id + 1`, 0 for an empty voxel.
+    Dense {
+        /// Smallest voxel coordinates.
+        lo: [i64; 3],
+        /// Box size in voxels.
+        dims: [usize; 3],
+        /// Id + 1 per voxel of the box.
+        ids: Vec<u32>,
+    },
+    /// Packed key ([`key3`]) to id; keys of voxels 2^21 apart collide.
+    Map(GridMap<u64, u32>),
+}
+
+impl VoxelIds {
+    /// Id of the voxel at `c` (with `Map`, possibly of a voxel aliased to
+    /// it), or `None` when no point fell in it.
+    #[inline]
+    pub fn get(&self, c: [i64; 3]) -> Option<u32> {
+        match self {
+            VoxelIds::Dense { lo, dims, ids } => {
+                let r = [
+                    c[0].wrapping_sub(lo[0]),
+                    c[1].wrapping_sub(lo[1]),
+                    c[2].wrapping_sub(lo[2]),
+                ];
+                if (0..3).any(|k| r[k] < 0 || r[k] as usize >= dims[k]) {
+                    return None;
+                }
+                let id = ids[(r[2] as usize * dims[1] + r[1] as usize) * dims[0] + r[0] as usize];
+                id.checked_sub(1)
+            }
+            VoxelIds::Map(map) => map.get(&key3(c[0], c[1], c[2])).copied(),
+        }
+    }
+
+    /// No voxel at all?
+    pub fn is_empty(&self) -> bool {
+        match self {
+            VoxelIds::Dense { ids, .. } => ids.is_empty(),
+            VoxelIds::Map(map) => map.is_empty(),
+        }
+    }
+}
+
+/// Assign `pts` to voxels of side `voxel`. Ids come in first-seen order
+/// whichever lookup is used, so results never depend on it. With the map,
+/// consecutive points of a scan are mostly neighbours along a ring, in one
+/// voxel: the last voxel is remembered and the lookup skipped for repeats.
 pub fn voxelise(pts: &[glam::Vec3], voxel: f64) -> Voxels {
     let inv = 1.0 / voxel;
+    let coord = |p: &glam::Vec3| {
+        [
+            floor_i64(p.x as f64 * inv),
+            floor_i64(p.y as f64 * inv),
+            floor_i64(p.z as f64 * inv),
+        ]
+    };
+    // The voxels' box: floor is monotone, so the voxels of the points' box
+    // corners bound every point's voxel (for finite points; a cloud with
+    // others uses the map).
+    let (mut plo, mut phi) = (
+        glam::Vec3::splat(f32::INFINITY),
+        glam::Vec3::splat(f32::NEG_INFINITY),
+    );
+    let mut finite = true;
+    for p in pts {
+        plo = plo.min(*p);
+        phi = phi.max(*p);
+        finite &= p.is_finite();
+    }
+    let (lo, hi) = (coord(&plo), coord(&phi));
+    let budget = (8 * pts.len() as u128).clamp(1 << 20, 1 << 23);
+    let size = (0..3).fold(1u128, |v, k| {
+        v.saturating_mul((hi[k] as i128 - lo[k] as i128 + 1).max(0) as u128)
+    });
     let mut out = Voxels {
         cell_of: Vec::with_capacity(pts.len()),
         coords: Vec::new(),
         aliased: Vec::new(),
-        map: GridMap::default(),
+        ids: VoxelIds::Map(GridMap::default()),
     };
-    let mut last = ([i64::MAX; 3], 0u32);
-    for p in pts {
-        let c = [
-            floor_i64(p.x as f64 * inv),
-            floor_i64(p.y as f64 * inv),
-            floor_i64(p.z as f64 * inv),
-        ];
-        if c != last.0 {
-            let next = out.coords.len() as u32;
-            let id = *out.map.entry(key3(c[0], c[1], c[2])).or_insert(next);
-            if id == next {
+    if pts.is_empty() {
+        return out;
+    }
+    if finite && size <= budget {
+        let dims = [0, 1, 2].map(|k| (hi[k] - lo[k] + 1) as usize);
+        let mut ids = vec![0u32; dims[0] * dims[1] * dims[2]];
+        for p in pts {
+            let c = coord(p);
+            let k = ((c[2] - lo[2]) as usize * dims[1] + (c[1] - lo[1]) as usize) * dims[0]
+                + (c[0] - lo[0]) as usize;
+            if ids[k] == 0 {
                 out.coords.push(c);
-            } else if out.coords[id as usize] != c {
-                out.aliased.push(c);
+                ids[k] = out.coords.len() as u32;
             }
-            last = (c, id);
+            out.cell_of.push(ids[k] - 1);
         }
-        out.cell_of.push(last.1);
+        out.ids = VoxelIds::Dense { lo, dims, ids };
+    } else {
+        let mut map = GridMap::default();
+        let mut last = ([i64::MAX; 3], 0u32);
+        for p in pts {
+            let c = coord(p);
+            // Compared lane by lane: comparing the arrays whole compiles to a
+            // wide load of just-stored words, which stalls every point.
+            if (c[0] ^ last.0[0]) | (c[1] ^ last.0[1]) | (c[2] ^ last.0[2]) != 0 {
+                let next = out.coords.len() as u32;
+                let id = *map.entry(key3(c[0], c[1], c[2])).or_insert(next);
+                if id == next {
+                    out.coords.push(c);
+                } else if out.coords[id as usize] != c {
+                    out.aliased.push(c);
+                }
+                last = (c, id);
+            }
+            out.cell_of.push(last.1);
+        }
+        out.ids = VoxelIds::Map(map);
     }
     out
 }
 
 #[cfg(test)]
 mod tests {
-    use super::{floor_i64, Buckets};
+    use super::{floor_i64, voxelise, Buckets, VoxelIds};
+    use glam::Vec3;
+
+    #[test]
+    fn dense_and_hashed_voxels_agree() {
+        // A compact cloud gets the dense array, a sparse one (two points
+        // 10^4 voxels apart on every axis) the map; ids, coordinates and
+        // lookups follow the same first-seen rule.
+        let mut rng = crate::rng::Rng::new(3);
+        let compact: Vec<Vec3> = (0..5000)
+            .map(|_| {
+                let f = |r: &mut crate::rng::Rng| r.below(20_000) as f32 * 1e-3 - 10.0;
+                Vec3::new(f(&mut rng), f(&mut rng), f(&mut rng))
+            })
+            .collect();
+        let mut sparse = compact.clone();
+        sparse.push(Vec3::splat(1e4));
+        let (a, b) = (voxelise(&compact, 0.5), voxelise(&sparse, 0.5));
+        assert!(matches!(a.ids, VoxelIds::Dense { .. }));
+        assert!(matches!(b.ids, VoxelIds::Map(_)));
+        assert_eq!(a.cell_of[..], b.cell_of[..compact.len()]);
+        assert_eq!(a.coords[..], b.coords[..a.coords.len()]);
+        for (id, &c) in a.coords.iter().enumerate() {
+            assert_eq!(a.ids.get(c), Some(id as u32));
+            assert_eq!(b.ids.get(c), Some(id as u32));
+        }
+        for c in [
+            [100, 0, 0],
+            [-21, 0, 0],
+            [0, 0, 20],
+            [i64::MIN, i64::MAX, 0],
+        ] {
+            assert_eq!(a.ids.get(c), None, "{c:?}");
+        }
+        assert_eq!(
+            b.ids.get([20_000, 20_000, 20_000]),
+            Some(a.coords.len() as u32)
+        );
+        assert!(voxelise(&[], 1.0).ids.is_empty());
+    }
 
     #[test]
     fn buckets_group_indices_by_cell_in_order() {

@@ -283,29 +283,31 @@ impl Footprint {
     /// how many cells were newly set. Non-finite points are ignored.
     pub fn mark_all(&mut self, points: &[DVec2]) -> usize {
         let inv = 1.0 / self.cell;
-        let mut lo = (i64::MAX, i64::MAX);
-        let mut hi = (i64::MIN, i64::MIN);
+        // The cells of the points' box corners bound every point's cell
+        // (the cell index is monotone in the coordinate).
+        let (mut plo, mut phi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
         for &p in points {
-            if !p.is_finite() {
-                continue;
+            if p.is_finite() {
+                plo = plo.min(p);
+                phi = phi.max(p);
             }
-            let (x, y) = cell_index(p, inv);
-            lo = (lo.0.min(x), lo.1.min(y));
-            hi = (hi.0.max(x), hi.1.max(y));
         }
-        if lo.0 > hi.0 {
+        if plo.x > phi.x {
             return 0;
         }
         // When the grid cannot grow that far, the points outside it are left out.
-        let _ = self.grow_to(lo, hi);
+        let _ = self.grow_to(cell_index(plo, inv), cell_index(phi, inv));
+        let (x0, y0, w, h) = (self.x0, self.y0, self.w as u64, self.h as u64);
         let mut fresh = 0;
         for &p in points {
             if !p.is_finite() {
                 continue;
             }
             let (x, y) = cell_index(p, inv);
-            let (x, y) = (x as i128 - self.x0 as i128, y as i128 - self.y0 as i128);
-            if x < 0 || y < 0 || x >= self.w as i128 || y >= self.h as i128 {
+            // Exact: |cell index| < 2^63 and |x0| is bounded, so the
+            // wrapped difference is in 0..w only when the true one is.
+            let (x, y) = (x.wrapping_sub(x0) as u64, y.wrapping_sub(y0) as u64);
+            if x >= w || y >= h {
                 continue;
             }
             let k = y as usize * self.w + x as usize;

@@ -3,7 +3,7 @@
 //! voxels its grown bounding box crosses near its plane, never to the whole
 //! scan.
 
-use crate::hash::{key3, Buckets, GridMap};
+use crate::hash::{Buckets, VoxelIds};
 use glam::{DVec3, Vec3};
 
 /// Points of a scan bucketed by cubic voxels.
@@ -11,12 +11,13 @@ pub struct ScanIndex {
     voxel: f64,
     /// Per voxel: the last visit stamp (see `for_each_near_plane`).
     visited: Vec<u32>,
-    map: GridMap<u64, u32>,
+    ids: VoxelIds,
     buckets: Buckets,
     lo: [i64; 3],
     hi: [i64; 3],
-    /// Dense occupancy bits over the voxel box `lo..=hi` (when it has at
-    /// most `MAX_DENSE` voxels): a cheap test before each hash lookup.
+    /// With hashed ids: dense occupancy bits over the voxel box `lo..=hi`
+    /// (when it has at most `MAX_DENSE` voxels), a cheap test before each
+    /// hash lookup. Empty with dense ids, which are as cheap.
     occ: Vec<u64>,
     dims: [usize; 3],
 }
@@ -40,7 +41,7 @@ impl ScanIndex {
             }
         }
         let (mut occ, mut dims) = (Vec::new(), [0usize; 3]);
-        if !pts.is_empty() {
+        if !pts.is_empty() && matches!(v.ids, VoxelIds::Map(_)) {
             let d = [0, 1, 2].map(|k| (hi[k] - lo[k] + 1) as u128);
             if d[0] * d[1] * d[2] <= MAX_DENSE as u128 {
                 dims = d.map(|x| x as usize);
@@ -55,7 +56,7 @@ impl ScanIndex {
         ScanIndex {
             voxel,
             visited: vec![0; cells],
-            map: v.map,
+            ids: v.ids,
             buckets,
             lo,
             hi,
@@ -93,7 +94,7 @@ impl ScanIndex {
         gate: f64,
         mut f: impl FnMut(&[u32]),
     ) {
-        if self.map.is_empty() {
+        if self.ids.is_empty() {
             return;
         }
         let v = self.voxel;
@@ -141,7 +142,7 @@ impl ScanIndex {
                     if !self.maybe_occupied(idx) {
                         continue;
                     }
-                    if let Some(&cell) = self.map.get(&key3(idx[0], idx[1], idx[2])) {
+                    if let Some(cell) = self.ids.get(idx) {
                         if self.visited[cell as usize] == stamp {
                             continue;
                         }
