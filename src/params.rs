@@ -458,7 +458,7 @@ fn closest_key<'a>(key: &str, keys: &'a [String]) -> Option<&'a str> {
     let norm = |s: &str| -> Vec<char> {
         s.chars()
             .filter(|c| *c != '_' && *c != '-')
-            .flat_map(char::to_lowercase)
+            .map(|c| c.to_ascii_lowercase())
             .collect()
     };
     let edits = |a: &[char], b: &[char]| {

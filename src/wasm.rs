@@ -368,7 +368,7 @@ fn describe(v: &JsValue) -> String {
         };
     }
     if let Some(s) = v.as_string() {
-        return format!("the string {s:?}");
+        return format!("the string \"{s}\"");
     }
     match v.as_f64() {
         Some(x) => format!("the number {x}"),

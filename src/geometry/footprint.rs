@@ -736,57 +736,25 @@ fn connect_runs(start: &[u32], runs: &[(u32, u32)]) -> Vec<u32> {
 /// the `2r + 1` rows around it: `O(cells * r)` integer work, far cheaper
 /// than a full distance transform for the small radii used here.
 pub(crate) fn dilate_disk(grid: &[bool], w: usize, h: usize, radius: f64) -> Vec<bool> {
-    // Row distances fit a byte for the radii outlines use (the inner loop
-    // then handles sixteen cells per SIMD lane group instead of four).
-    if radius.max(0.0).floor() < 255.0 {
-        dilate_disk_with::<u8>(grid, w, h, radius)
-    } else {
-        dilate_disk_with::<u32>(grid, w, h, radius)
-    }
-}
-
-/// Row distance counters for [`dilate_disk`].
-trait RowDistance: Copy + Ord {
-    /// `v` (callers keep it in range).
-    fn of(v: u32) -> Self;
-    /// `self + 1`, at most `cap`.
-    fn step(self, cap: Self) -> Self;
-}
-
-impl RowDistance for u8 {
-    fn of(v: u32) -> Self {
-        v.min(255) as u8
-    }
-    fn step(self, cap: Self) -> Self {
-        self.saturating_add(1).min(cap)
-    }
-}
-
-impl RowDistance for u32 {
-    fn of(v: u32) -> Self {
-        v
-    }
-    fn step(self, cap: Self) -> Self {
-        self.saturating_add(1).min(cap)
-    }
-}
-
-fn dilate_disk_with<T: RowDistance>(grid: &[bool], w: usize, h: usize, radius: f64) -> Vec<bool> {
+    // Row distances in 16 bits (eight cells per SIMD operation): exact for
+    // radii up to 65534 cells. Callers stay far below (outlines at most
+    // 4096 cells, growth masks about 1000); beyond that the radius is
+    // clamped.
+    let radius = radius.min(65534.0);
     let r = radius.max(0.0).floor() as usize;
-    let cap32 = (r + 1).min(u32::MAX as usize) as u32;
-    let (cap, zero) = (T::of(cap32), T::of(0));
+    let cap = (r + 1) as u16;
     let mut hd = vec![cap; w * h];
     for y in 0..h {
         let row = &grid[y * w..(y + 1) * w];
         let out = &mut hd[y * w..(y + 1) * w];
         let mut last = cap;
         for x in 0..w {
-            last = if row[x] { zero } else { last.step(cap) };
+            last = if row[x] { 0 } else { (last + 1).min(cap) };
             out[x] = last;
         }
         last = cap;
         for x in (0..w).rev() {
-            last = if row[x] { zero } else { last.step(cap) };
+            last = if row[x] { 0 } else { (last + 1).min(cap) };
             out[x] = out[x].min(last);
         }
     }
@@ -794,13 +762,13 @@ fn dilate_disk_with<T: RowDistance>(grid: &[bool], w: usize, h: usize, radius: f
     // most reach[|dy|] (integer: dx^2 + dy^2 <= radius^2); rows with no
     // reach (radius < dy) are skipped.
     let lim = radius * radius;
-    let reach: Vec<Option<T>> = (0..=r)
+    let reach: Vec<Option<u16>> = (0..=r)
         .map(|dy| {
             let mut dx = r as u64;
             while dx > 0 && (dx * dx) as f64 + (dy * dy) as f64 > lim {
                 dx -= 1;
             }
-            (((dx * dx) as f64 + (dy * dy) as f64) <= lim).then(|| T::of(dx as u32))
+            (((dx * dx) as f64 + (dy * dy) as f64) <= lim).then_some(dx as u16)
         })
         .collect();
     // Row by row: OR in the rows of the window, a branch-free pass each
