@@ -409,16 +409,12 @@ impl Footprint {
                 factor *= 2;
                 continue;
             }
-            let mut grid = vec![false; gw * gh];
+            let mut grid = BitGrid::new(gw, gh);
             for y in ly..=hy {
-                let row = ((y - ly) / factor + m) * gw + m;
-                if factor == 1 {
-                    self.row_set_cells(y, |x| grid[row + x - lx] = true);
-                } else {
-                    self.row_set_cells(y, |x| grid[row + (x - lx) / factor] = true);
-                }
+                let gy = (y - ly) / factor + m;
+                self.row_set_cells(y, |x| grid.set((x - lx) / factor + m, gy));
             }
-            let (corners, inside) = trace_region(grid, gw, gh, r)?;
+            let (corners, inside) = trace_region(grid, r)?;
             let cs = self.cell * factor as f64;
             let ox = (self.x0 + lx as i64) as f64 * self.cell - m as f64 * cs;
             let oy = (self.y0 + ly as i64) as f64 * self.cell - m as f64 * cs;
@@ -525,21 +521,21 @@ fn inset_rectilinear(ring: &[DVec2], d: f64) -> Vec<DVec2> {
 /// A traced region: its outer ring (grid corners) and its cells.
 type Traced = (Vec<(i64, i64)>, Vec<bool>);
 
-fn trace_region(grid: Vec<bool>, w: usize, h: usize, r: usize) -> Option<Traced> {
-    if w == 0 || h == 0 || grid.len() != w * h {
+fn trace_region(grid: BitGrid, r: usize) -> Option<Traced> {
+    let (w, h) = (grid.w, grid.h);
+    if w == 0 || h == 0 {
         return None;
     }
     let closed = if r > 0 {
-        let dil = dilate_disk(&grid, w, h, r as f64);
-        let outside: Vec<bool> = dil.iter().map(|&b| !b).collect();
-        dilate_disk(&outside, w, h, r as f64)
-            .into_iter()
-            .map(|b| !b)
-            .collect::<Vec<bool>>()
+        let mut outside = dilate_bits(&grid, r as f64);
+        outside.invert();
+        let mut closed = dilate_bits(&outside, r as f64);
+        closed.invert();
+        closed
     } else {
         grid
     };
-    let outside = exterior_of_largest_region(&closed, w, h)?;
+    let outside = exterior_of_largest_region(&closed)?;
     let inside = |x: i64, y: i64| -> bool {
         x >= 0
             && y >= 0
@@ -599,13 +595,14 @@ fn trace_region(grid: Vec<bool>, w: usize, h: usize, r: usize) -> Option<Traced>
 /// in row-major order of equally large ones) with its holes filled: those
 /// reachable from the grid's border without crossing the region. `None`
 /// when no cell is set.
-fn exterior_of_largest_region(closed: &[bool], w: usize, h: usize) -> Option<Vec<bool>> {
+fn exterior_of_largest_region(closed: &BitGrid) -> Option<Vec<bool>> {
+    let (w, h) = (closed.w, closed.h);
     // Largest 4-connected region (first found wins ties: row-major order),
     // then its holes filled: everything not reachable from the border
     // through non-region cells belongs to it. Both on horizontal runs of
     // cells joined by union-find (rows overlap in a column: 4-connected),
     // which costs a pass over the cells plus work per run, not per cell.
-    let (row_start, runs) = runs_of(w, h, |y| &closed[y * w..(y + 1) * w]);
+    let (row_start, runs) = closed.runs();
     let root = connect_runs(&row_start, &runs);
     let mut size = vec![0usize; runs.len()];
     for (k, &(x0, x1)) in runs.iter().enumerate() {
@@ -663,36 +660,212 @@ fn exterior_of_largest_region(closed: &[bool], w: usize, h: usize) -> Option<Vec
     Some(outside)
 }
 
-/// Horizontal runs `[x0, x1)` of set cells, row by row (`row(y)` gives row
-/// `y`): the runs of row `y` are `runs[start[y]..start[y + 1]]`.
-fn runs_of<'g>(
+/// A raster of bits, row by row, each row padded to whole 64-bit words
+/// (padding bits always clear). Morphology on it works on 64 cells at a
+/// time with plain integer operations, as fast in wasm as natively.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct BitGrid {
     w: usize,
     h: usize,
-    row: impl Fn(usize) -> &'g [bool],
-) -> (Vec<u32>, Vec<(u32, u32)>) {
-    let mut start = Vec::with_capacity(h + 1);
-    let mut runs = Vec::new();
-    for y in 0..h {
-        start.push(runs.len() as u32);
-        let r = row(y);
-        let mut x = 0;
-        while x < w {
-            if !r[x] {
-                x += 1;
-                continue;
-            }
-            let x0 = x;
-            while x < w && r[x] {
-                x += 1;
-            }
-            runs.push((x0 as u32, x as u32));
-        }
-    }
-    start.push(runs.len() as u32);
-    (start, runs)
+    stride: usize,
+    words: Vec<u64>,
 }
 
-/// Union-find over runs (as made by [`runs_of`]): runs in consecutive rows
+impl BitGrid {
+    /// All clear, `w` by `h` cells.
+    pub(crate) fn new(w: usize, h: usize) -> Self {
+        let stride = w.div_ceil(64);
+        BitGrid {
+            w,
+            h,
+            stride,
+            words: vec![0; stride * h],
+        }
+    }
+
+    /// From one bool per cell, row-major.
+    pub(crate) fn from_bools(cells: &[bool], w: usize, h: usize) -> Self {
+        let mut g = BitGrid::new(w, h);
+        for (k, _) in cells.iter().enumerate().take(w * h).filter(|(_, &c)| c) {
+            g.set(k % w, k / w);
+        }
+        g
+    }
+
+    /// One bool per cell, row-major.
+    pub(crate) fn to_bools(&self) -> Vec<bool> {
+        let mut out = vec![false; self.w * self.h];
+        for y in 0..self.h {
+            for (x0, x1) in self.row_runs(y) {
+                out[y * self.w + x0 as usize..y * self.w + x1 as usize].fill(true);
+            }
+        }
+        out
+    }
+
+    #[inline]
+    pub(crate) fn set(&mut self, x: usize, y: usize) {
+        self.words[y * self.stride + x / 64] |= 1 << (x % 64);
+    }
+
+    fn row(&self, y: usize) -> &[u64] {
+        &self.words[y * self.stride..(y + 1) * self.stride]
+    }
+
+    /// Mask of the valid bits of a row's last word.
+    fn tail_mask(&self) -> u64 {
+        match self.w % 64 {
+            0 => !0,
+            k => (1 << k) - 1,
+        }
+    }
+
+    /// Flip every cell (padding stays clear).
+    fn invert(&mut self) {
+        let tail = self.tail_mask();
+        for row in self.words.chunks_exact_mut(self.stride.max(1)) {
+            for v in row.iter_mut() {
+                *v = !*v;
+            }
+            if let Some(last) = row.last_mut() {
+                *last &= tail;
+            }
+        }
+    }
+
+    /// The runs `[x0, x1)` of set cells of row `y`, left to right.
+    fn row_runs(&self, y: usize) -> impl Iterator<Item = (u32, u32)> + '_ {
+        let row = self.row(y);
+        // First set (want = true) or clear (want = false) cell at or after x.
+        let find = move |x: usize, want: bool| -> usize {
+            let mut i = x / 64;
+            if i >= row.len() {
+                return self.w;
+            }
+            let flip = if want { 0 } else { !0 };
+            let mut v = (row[i] ^ flip) & (!0u64 << (x % 64));
+            loop {
+                if v != 0 {
+                    return (i * 64 + v.trailing_zeros() as usize).min(self.w);
+                }
+                i += 1;
+                if i >= row.len() {
+                    return self.w;
+                }
+                v = row[i] ^ flip;
+            }
+        };
+        let mut x = 0;
+        std::iter::from_fn(move || {
+            let x0 = find(x, true);
+            if x0 >= self.w {
+                return None;
+            }
+            let x1 = find(x0, false);
+            x = x1;
+            Some((x0 as u32, x1 as u32))
+        })
+    }
+
+    /// Horizontal runs of set cells, row by row: the runs of row `y` are
+    /// `runs[start[y]..start[y + 1]]`.
+    fn runs(&self) -> (Vec<u32>, Vec<(u32, u32)>) {
+        let mut start = Vec::with_capacity(self.h + 1);
+        let mut runs = Vec::new();
+        for y in 0..self.h {
+            start.push(runs.len() as u32);
+            runs.extend(self.row_runs(y));
+        }
+        start.push(runs.len() as u32);
+        (start, runs)
+    }
+}
+
+/// `dst = src` grown by one cell left and right (within `tail` in the last
+/// word).
+fn widen_row(src: &[u64], dst: &mut [u64], tail: u64) {
+    let n = src.len();
+    for i in 0..n {
+        let left = if i > 0 { src[i - 1] >> 63 } else { 0 };
+        let right = if i + 1 < n { src[i + 1] << 63 } else { 0 };
+        dst[i] = src[i] | src[i] << 1 | src[i] >> 1 | left | right;
+    }
+    if let Some(last) = dst.last_mut() {
+        *last &= tail;
+    }
+}
+
+/// Binary dilation by a disk of `radius` cells (centre to centre), exact:
+/// a cell is set when a set cell lies `dy` rows away and at most
+/// `reach(dy) = max { dx : dx^2 + dy^2 <= radius^2 }` columns away. Each
+/// source row is widened one column at a time (`reach(0)` passes of a few
+/// word operations) and each widening ORed into the rows whose `dy` needs
+/// it: `O(cells / 64 * radius)` word operations.
+fn dilate_bits(grid: &BitGrid, radius: f64) -> BitGrid {
+    let (w, h, stride) = (grid.w, grid.h, grid.stride);
+    let mut out = BitGrid::new(w, h);
+    if w == 0 || h == 0 {
+        return out;
+    }
+    // A radius beyond the grid's diagonal reaches every cell: capping it at
+    // w + h changes nothing.
+    let radius = if radius.is_nan() {
+        0.0
+    } else {
+        radius.clamp(0.0, (w + h) as f64)
+    };
+    let r = radius.floor() as usize;
+    let lim = radius * radius;
+    // reach[dy] for the dy that stay inside the grid (every dy <= r has
+    // reach >= 0); the square root is a first guess, made exact below.
+    let reach: Vec<usize> = (0..=r.min(h))
+        .map(|dy| {
+            let dy2 = (dy * dy) as f64;
+            let mut dx = (lim - dy2).max(0.0).sqrt() as u64;
+            while ((dx + 1) * (dx + 1)) as f64 + dy2 <= lim {
+                dx += 1;
+            }
+            while dx > 0 && (dx * dx) as f64 + dy2 > lim {
+                dx -= 1;
+            }
+            // Widening a row more than its width changes nothing.
+            (dx as usize).min(w)
+        })
+        .collect();
+    let tail = grid.tail_mask();
+    let (mut cur, mut next) = (vec![0u64; stride], vec![0u64; stride]);
+    for y in 0..h {
+        let src = grid.row(y);
+        if src.iter().all(|&v| v == 0) {
+            continue;
+        }
+        cur.copy_from_slice(src);
+        // reach is non-increasing in dy: walk dy from r down to 0 while the
+        // widening grows from 0 to reach[0].
+        let mut k = 0;
+        for dy in (0..=r.min(h)).rev() {
+            while k < reach[dy] {
+                widen_row(&cur, &mut next, tail);
+                std::mem::swap(&mut cur, &mut next);
+                k += 1;
+            }
+            for ty in [y.checked_sub(dy), (dy > 0).then_some(y + dy)]
+                .into_iter()
+                .flatten()
+            {
+                if ty < h {
+                    let dst = &mut out.words[ty * stride..(ty + 1) * stride];
+                    for (d, &c) in dst.iter_mut().zip(&cur) {
+                        *d |= c;
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Union-find over runs (as made by [`BitGrid::runs`]): runs in consecutive rows
 /// that share a column are joined. Returns each run's root, the lowest run
 /// index of its component (its first run in row-major order).
 fn connect_runs(start: &[u32], runs: &[(u32, u32)]) -> Vec<u32> {
@@ -731,64 +904,10 @@ fn connect_runs(start: &[u32], runs: &[(u32, u32)]) -> Vec<u32> {
 }
 
 /// Cells whose centre lies within `radius` cells of the centre of a set cell
-/// (binary dilation by a disk). Exact: per row the distance to the nearest
-/// set cell in that row is computed in two sweeps, then each cell looks at
-/// the `2r + 1` rows around it: `O(cells * r)` integer work, far cheaper
-/// than a full distance transform for the small radii used here.
+/// (binary dilation by a disk), one bool per cell: [`dilate_bits`] on the
+/// packed grid.
 pub(crate) fn dilate_disk(grid: &[bool], w: usize, h: usize, radius: f64) -> Vec<bool> {
-    // Row distances in 16 bits (eight cells per SIMD operation): exact for
-    // radii up to 65534 cells. Callers stay far below (outlines at most
-    // 4096 cells, growth masks about 1000); beyond that the radius is
-    // clamped.
-    let radius = radius.min(65534.0);
-    let r = radius.max(0.0).floor() as usize;
-    let cap = (r + 1) as u16;
-    let mut hd = vec![cap; w * h];
-    for y in 0..h {
-        let row = &grid[y * w..(y + 1) * w];
-        let out = &mut hd[y * w..(y + 1) * w];
-        let mut last = cap;
-        for x in 0..w {
-            last = if row[x] { 0 } else { (last + 1).min(cap) };
-            out[x] = last;
-        }
-        last = cap;
-        for x in (0..w).rev() {
-            last = if row[x] { 0 } else { (last + 1).min(cap) };
-            out[x] = out[x].min(last);
-        }
-    }
-    // A cell at row offset dy is within the disk when the row distance is at
-    // most reach[|dy|] (integer: dx^2 + dy^2 <= radius^2); rows with no
-    // reach (radius < dy) are skipped.
-    let lim = radius * radius;
-    let reach: Vec<Option<u16>> = (0..=r)
-        .map(|dy| {
-            let mut dx = r as u64;
-            while dx > 0 && (dx * dx) as f64 + (dy * dy) as f64 > lim {
-                dx -= 1;
-            }
-            (((dx * dx) as f64 + (dy * dy) as f64) <= lim).then_some(dx as u16)
-        })
-        .collect();
-    // Row by row: OR in the rows of the window, a branch-free pass each
-    // (the compiler vectorises it).
-    let mut out = vec![false; w * h];
-    for y in 0..h {
-        let y0 = y.saturating_sub(r);
-        let y1 = (y + r).min(h - 1);
-        let o = &mut out[y * w..(y + 1) * w];
-        for yy in y0..=y1 {
-            let Some(lim) = reach[yy.abs_diff(y)] else {
-                continue;
-            };
-            let row = &hd[yy * w..(yy + 1) * w];
-            for (b, &d) in o.iter_mut().zip(row) {
-                *b |= d <= lim;
-            }
-        }
-    }
-    out
+    dilate_bits(&BitGrid::from_bools(grid, w, h), radius).to_bools()
 }
 
 /// Exact squared Euclidean distance (in cells) from every cell to the nearest
@@ -1020,7 +1139,7 @@ mod tests {
             let fill = 20 + rng.below(60);
             let grid: Vec<bool> = (0..w * h).map(|_| rng.below(100) < fill).collect();
             let expected = region_by_flood_fill(&grid, w, h);
-            let got = exterior_of_largest_region(&grid, w, h)
+            let got = exterior_of_largest_region(&BitGrid::from_bools(&grid, w, h))
                 .map(|outside| outside.into_iter().map(|o| !o).collect::<Vec<bool>>());
             if let Some(e) = &expected {
                 holes += (0..w * h).filter(|&k| e[k] && !grid[k]).count();
@@ -1050,15 +1169,23 @@ mod tests {
 
     #[test]
     fn disk_dilation_matches_the_distance_transform() {
-        let (w, h) = (23, 17);
-        let grid: Vec<bool> = (0..w * h)
-            .map(|k| k % 11 == 0 || k == 100 || k == 101)
-            .collect();
-        let d = sq_edt(&grid, w, h);
-        for radius in [0.0, 1.0, 1.5, 2.0, 3.7, 6.0] {
-            let dil = dilate_disk(&grid, w, h, radius);
-            for k in 0..w * h {
-                assert_eq!(dil[k], d[k] <= radius * radius, "radius {radius} cell {k}");
+        // Widths below, at and across the 64-bit word boundary, sparse and
+        // dense grids, radii from none to beyond the grid.
+        let mut rng = crate::rng::Rng::new(9);
+        for (w, h) in [(23, 17), (64, 9), (65, 12), (130, 7), (1, 40), (200, 1)] {
+            for fill in [2, 30] {
+                let grid: Vec<bool> = (0..w * h).map(|_| rng.below(100) < fill).collect();
+                let d = sq_edt(&grid, w, h);
+                for radius in [0.0, 1.0, 1.5, 2.0, 3.7, 6.0, 70.5, 1e9] {
+                    let dil = dilate_disk(&grid, w, h, radius);
+                    for k in 0..w * h {
+                        assert_eq!(
+                            dil[k],
+                            d[k] <= radius * radius,
+                            "{w}x{h} fill {fill} radius {radius} cell {k}"
+                        );
+                    }
+                }
             }
         }
     }
