@@ -225,8 +225,7 @@ pub fn voxelise(pts: &[glam::Vec3], voxel: f64) -> Voxels {
     );
     let mut finite = true;
     for p in pts {
-        plo = plo.min(*p);
-        phi = phi.max(*p);
+        crate::geometry::grow_box(&mut plo, &mut phi, *p);
         finite &= p.is_finite();
     }
     let (lo, hi) = (coord(&plo), coord(&phi));

@@ -70,7 +70,7 @@ impl Rng {
     /// Uniform integer in `0..n` (`n > 0`; returns 0 for `n == 0`).
     #[inline]
     pub fn below(&mut self, n: usize) -> usize {
-        ((self.next_u64() as u128 * n as u128) >> 64) as usize
+        mul_high(self.next_u64(), n as u64) as usize
     }
 
     /// Standard normal sample (Box–Muller).
@@ -81,9 +81,50 @@ impl Rng {
     }
 }
 
+/// The high 64 bits of the 128-bit product `a * b`. In wasm a `u128`
+/// multiply is a library call; [`mul_high_parts`] gives the same bits
+/// there.
+#[inline]
+fn mul_high(a: u64, b: u64) -> u64 {
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        ((a as u128 * b as u128) >> 64) as u64
+    }
+    #[cfg(target_arch = "wasm32")]
+    {
+        mul_high_parts(a, b)
+    }
+}
+
+/// [`mul_high`] from four 32-bit partial products.
+#[cfg_attr(not(any(target_arch = "wasm32", test)), allow(dead_code))]
+#[inline]
+fn mul_high_parts(a: u64, b: u64) -> u64 {
+    let (al, ah) = (a & 0xFFFF_FFFF, a >> 32);
+    let (bl, bh) = (b & 0xFFFF_FFFF, b >> 32);
+    let (ll, lh, hl, hh) = (al * bl, al * bh, ah * bl, ah * bh);
+    let mid = (ll >> 32) + (lh & 0xFFFF_FFFF) + (hl & 0xFFFF_FFFF);
+    hh + (lh >> 32) + (hl >> 32) + (mid >> 32)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn partial_products_give_the_high_word() {
+        let mut r = Rng::new(1);
+        let edge = [0, 1, u32::MAX as u64, 1 << 32, u64::MAX - 1, u64::MAX];
+        for &a in &edge {
+            for &b in &edge {
+                assert_eq!(mul_high_parts(a, b), ((a as u128 * b as u128) >> 64) as u64);
+            }
+        }
+        for _ in 0..10_000 {
+            let (a, b) = (r.next_u64(), r.next_u64());
+            assert_eq!(mul_high_parts(a, b), ((a as u128 * b as u128) >> 64) as u64);
+        }
+    }
 
     #[test]
     fn same_seed_same_sequence_and_streams_differ() {

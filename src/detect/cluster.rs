@@ -144,10 +144,19 @@ impl Clusterer {
         );
         for (p, &c) in points.iter().zip(&self.cell_of) {
             let b = &mut self.bbox[c as usize];
-            b[0] = b[0].min(p.x);
-            b[1] = b[1].min(p.y);
-            b[2] = b[2].max(p.x);
-            b[3] = b[3].max(p.y);
+            // Comparisons, not f64::min/max (library calls in wasm).
+            if p.x < b[0] {
+                b[0] = p.x;
+            }
+            if p.y < b[1] {
+                b[1] = p.y;
+            }
+            if p.x > b[2] {
+                b[2] = p.x;
+            }
+            if p.y > b[3] {
+                b[3] = p.y;
+            }
         }
         // Half neighbourhood (each unordered pair once) whose boxes are < tol apart.
         let mut offsets = Vec::new();

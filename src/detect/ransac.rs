@@ -147,8 +147,7 @@ impl<'a> PlanePool<'a> {
             let members = &cell_pts[buckets.range(c)];
             let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
             for p in members {
-                lo = lo.min(p.as_dvec3());
-                hi = hi.max(p.as_dvec3());
+                crate::geometry::grow_box(&mut lo, &mut hi, p.as_dvec3());
             }
             cell_box.push(((lo + hi) * 0.5, (hi - lo) * 0.5));
             cell_live.push(members.len() as u32);
@@ -411,7 +410,9 @@ impl<'a> PlanePool<'a> {
             self.pts[i3 as usize].as_dvec3(),
         );
         let cr = (p2 - p1).cross(p3 - p1);
-        let len = cr.length();
+        // std sqrt (a single instruction in wasm; glam with libm calls software):
+        // both are correctly rounded, so the bits are the same.
+        let len = cr.length_squared().sqrt();
         // Twice the triangle area must exceed 1 cm^2: no near-collinear triples.
         if len.is_nan() || len <= 1e-4 {
             return None;

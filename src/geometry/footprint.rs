@@ -288,8 +288,7 @@ impl Footprint {
         let (mut plo, mut phi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
         for &p in points {
             if p.is_finite() {
-                plo = plo.min(p);
-                phi = phi.max(p);
+                super::grow_box(&mut plo, &mut phi, p);
             }
         }
         if plo.x > phi.x {

@@ -12,3 +12,67 @@ pub use footprint::{Footprint, Region};
 pub use hull::convex_hull;
 pub use plane::{Frame, Moments, Plane, UP};
 pub use polygon::Polygon3;
+
+/// Grow the box `[lo, hi]` to hold `p`, by plain comparisons. (`f64::min`
+/// and `max` become library calls in wasm, whose `f64.min` treats NaN
+/// differently; these loops run once per point. NaN coordinates are
+/// ignored, as `min`/`max` ignore them.)
+#[inline]
+pub(crate) fn grow_box<T: BoxCoords>(lo: &mut T, hi: &mut T, p: T) {
+    for k in 0..T::DIM {
+        let v = p.get(k);
+        if v < lo.get(k) {
+            lo.set(k, v);
+        }
+        if v > hi.get(k) {
+            hi.set(k, v);
+        }
+    }
+}
+
+/// Points [`grow_box`] works on.
+pub(crate) trait BoxCoords: Copy {
+    /// Number of coordinates.
+    const DIM: usize;
+    /// Coordinate `k` (as f64).
+    fn get(&self, k: usize) -> f64;
+    /// Set coordinate `k`.
+    fn set(&mut self, k: usize, v: f64);
+}
+
+impl BoxCoords for glam::DVec2 {
+    const DIM: usize = 2;
+    #[inline]
+    fn get(&self, k: usize) -> f64 {
+        self[k]
+    }
+    #[inline]
+    fn set(&mut self, k: usize, v: f64) {
+        self[k] = v;
+    }
+}
+
+impl BoxCoords for glam::DVec3 {
+    const DIM: usize = 3;
+    #[inline]
+    fn get(&self, k: usize) -> f64 {
+        self[k]
+    }
+    #[inline]
+    fn set(&mut self, k: usize, v: f64) {
+        self[k] = v;
+    }
+}
+
+impl BoxCoords for glam::Vec3 {
+    const DIM: usize = 3;
+    #[inline]
+    fn get(&self, k: usize) -> f64 {
+        self[k] as f64
+    }
+    #[inline]
+    fn set(&mut self, k: usize, v: f64) {
+        // Exact: v is one of the f32 coordinates.
+        self[k] = v as f32;
+    }
+}
