@@ -89,8 +89,7 @@ pub(crate) fn expand(
         for (k, &t) in taken.iter().enumerate() {
             if t {
                 let p = cloud.points[cand[k] as usize].as_dvec3();
-                tlo = tlo.min(p);
-                thi = thi.max(p);
+                crate::geometry::grow_box(&mut tlo, &mut thi, p);
             }
         }
         let reach = DVec3::splat(along + across);
