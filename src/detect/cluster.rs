@@ -178,8 +178,8 @@ impl Clusterer {
         // cells without a close pair would otherwise cost the product of
         // their sizes).
         let box_gap2 = |p: DVec2, b: &[f64; 4]| {
-            let dx = (b[0] - p.x).max(p.x - b[2]).max(0.0);
-            let dy = (b[1] - p.y).max(p.y - b[3]).max(0.0);
+            let dx = max0(b[0] - p.x, p.x - b[2]);
+            let dy = max0(b[1] - p.y, p.y - b[3]);
             dx * dx + dy * dy
         };
         self.parent.clear();
@@ -203,8 +203,8 @@ impl Clusterer {
                     continue;
                 }
                 let (ba, bb) = (&self.bbox[c], &self.bbox[nb as usize]);
-                let gx = (bb[0] - ba[2]).max(ba[0] - bb[2]).max(0.0);
-                let gy = (bb[1] - ba[3]).max(ba[1] - bb[3]).max(0.0);
+                let gx = max0(bb[0] - ba[2], ba[0] - bb[2]);
+                let gy = max0(bb[1] - ba[3], ba[1] - bb[3]);
                 if gx * gx + gy * gy >= tol2 {
                     continue;
                 }
@@ -248,14 +248,28 @@ impl Clusterer {
                 self.ids[(cy - lo.1) as usize * gw + (cx - lo.0) as usize] = u32::MAX;
             }
         }
+        // Roots once per cell, then per point a lookup.
+        let root: Vec<u32> = (0..cells as u32).map(|c| find(parent, c)).collect();
         let mut size = vec![0u32; cells];
         let mut root_of_point = Vec::with_capacity(n);
         for &c in &self.cell_of {
-            let r = find(parent, c);
+            let r = root[c as usize];
             size[r as usize] += 1;
             root_of_point.push(r);
         }
         (root_of_point, size)
+    }
+}
+
+/// `max(a, b, 0)` by comparisons (`f64::max` is a library call in wasm);
+/// the gaps it computes are finite.
+#[inline]
+fn max0(a: f64, b: f64) -> f64 {
+    let m = if b > a { b } else { a };
+    if m > 0.0 {
+        m
+    } else {
+        0.0
     }
 }
 
