@@ -158,38 +158,67 @@ fn drive_through(layout: Layout) {
         .sum::<DVec3>()
         / SCANS as f64;
     let cloud = common::cloud(&pts);
-    let one = polyscene::detect::detect(
-        &cloud,
-        &Params {
+    // Two one-shot baselines on the accumulated cloud: gpp2 as it is, whose
+    // cascade stops after ten rejections in a row (on 12M points that is
+    // right after the large, well-supported surfaces), and the same cascade
+    // run to completion (no rejection stop: it ends when no plane has
+    // `minInliers` support or at its round limit), which also goes after
+    // the smaller surfaces the scenario maps.
+    let one_shot = |max_rejections: usize| {
+        let params = Params {
             viewpoint: mean_pose.to_array(),
+            max_rejections,
             ..Params::gpp2()
-        },
-    )
-    .unwrap();
-    let one_polys: Vec<Polygon3> = one.primitives.iter().map(|p| p.polygon()).collect();
-    let shot = eval::evaluate(&one_polys, &gt, &pts, &labels, pts.len(), &opts).unwrap();
+        };
+        let one = polyscene::detect::detect(&cloud, &params).unwrap();
+        let polys: Vec<Polygon3> = one.primitives.iter().map(|p| p.polygon()).collect();
+        let e = eval::evaluate(&polys, &gt, &pts, &labels, pts.len(), &opts).unwrap();
+        (e, polys.len())
+    };
+    let (shot, shot_n) = one_shot(Params::gpp2().max_rejections);
+    let (full, full_n) = one_shot(1_000_000);
+    let line = |name: &str, e: &eval::Metrics, n: usize| {
+        format!(
+            "{name} P {:.3} R {:.3} H {:.4} C {:.3} n {n} d {}",
+            e.detection.precision,
+            e.detection.recall,
+            e.accuracy.mean.unwrap(),
+            e.completeness.completeness,
+            e.duplicates.count
+        )
+    };
     eprintln!(
-        "{layout:?}: incremental P {:.3} R {:.3} H {:.4} C {:.3} n {} d {} | one-shot P {:.3} R {:.3} H {:.4} C {:.3} n {} d {} | explained median {:.3} min {:.3}",
-        inc.detection.precision,
-        inc.detection.recall,
-        inc.accuracy.mean.unwrap(),
-        inc.completeness.completeness,
-        nw,
-        inc.duplicates.count,
-        shot.detection.precision,
-        shot.detection.recall,
-        shot.accuracy.mean.unwrap(),
-        shot.completeness.completeness,
-        one_polys.len(),
-        shot.duplicates.count,
-        share,
-        least
+        "{layout:?}: {} | {} | {} | explained median {share:.3} min {least:.3}",
+        line("incremental", &inc, nw),
+        line("one-shot", &shot, shot_n),
+        line("one-shot to completion", &full, full_n),
     );
-    // One-shot detection of the accumulated 12M points stops after the
-    // large, well-supported surfaces (recall 0.08-0.15, precision 1.0, mean
-    // error 4-10 mm, a few duplicates); the scenario finds 3-5x more of the
-    // scene, with vehicle faces (28 mm mean error) among them, so its mean
-    // error and precision are not lower than one-shot's. What it must beat:
+    // At least as good as the complete one-shot on every measure.
+    assert!(
+        inc.detection.precision >= full.detection.precision,
+        "precision vs complete one-shot"
+    );
+    assert!(
+        inc.detection.recall >= full.detection.recall,
+        "recall vs complete one-shot"
+    );
+    assert!(
+        inc.accuracy.mean.unwrap() <= full.accuracy.mean.unwrap(),
+        "mean Hausdorff vs complete one-shot"
+    );
+    assert!(
+        inc.completeness.completeness >= full.completeness.completeness,
+        "completeness vs complete one-shot"
+    );
+    assert!(
+        inc.duplicates.count <= full.duplicates.count,
+        "duplicates vs complete one-shot"
+    );
+    // The stopped one-shot keeps only the large surfaces (recall 0.08-0.15,
+    // precision 1.0, mean error 4-10 mm); the scenario finds 3-5x more of
+    // the scene, vehicle faces (28 mm mean error) among them, so its
+    // precision and mean error are slightly behind that selection's. It
+    // must beat it on what it is for:
     assert!(inc.detection.recall > 2.0 * shot.detection.recall, "recall");
     assert!(
         inc.completeness.completeness > shot.completeness.completeness,
