@@ -23,17 +23,28 @@
 
 use super::index::ScanIndex;
 use crate::cloud::Cloud;
-use crate::detect::cluster::clusters;
+use crate::detect::cluster::Clusterer;
 use crate::geometry::convex_hull;
 use crate::geometry::mask::{GrownMask, Zone};
 use crate::params::{HullKind, Params};
 use crate::primitive::Primitive;
 use glam::{DVec2, DVec3};
 
+/// Working memory kept across the primitives of one scan (fresh buffers per
+/// primitive cost more in allocation than some primitives' whole growth,
+/// in wasm especially).
+#[derive(Default)]
+pub(crate) struct Scratch {
+    clusterer: Clusterer,
+    cand: Vec<u32>,
+    q: Vec<DVec2>,
+}
+
 /// Grow `prim` with the live points of `cloud`; marks taken points dead in
 /// `alive`, writes `label` into `labels` for them and returns how many.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn expand(
+    scratch: &mut Scratch,
     prim: &mut Primitive,
     cloud: &Cloud,
     index: &mut ScanIndex,
@@ -60,8 +71,9 @@ pub(crate) fn expand(
 
     // 1. Perpendicular gate, over the voxels near the plane in the box; the
     //    box is enlarged while the growth reaches its edge.
-    let mut cand: Vec<u32> = Vec::new();
-    let mut q: Vec<DVec2> = Vec::new();
+    let Scratch { clusterer, cand, q } = scratch;
+    cand.clear();
+    q.clear();
     let mut taken: Vec<bool>;
     let mut inner: Vec<bool>;
     let mut outside: bool;
@@ -82,7 +94,7 @@ pub(crate) fn expand(
             }
         });
         // 2. Longitudinal growth.
-        (taken, inner, outside) = grow(&prim.outline, &q, along, params);
+        (taken, inner, outside) = grow(&prim.outline, q, along, params, clusterer);
         // Does the taken region reach the edge of the gathered box?
         let mut tlo = DVec3::splat(f64::INFINITY);
         let mut thi = DVec3::splat(f64::NEG_INFINITY);
@@ -165,6 +177,7 @@ fn grow(
     q: &[DVec2],
     along: f64,
     params: &Params,
+    clusterer: &mut Clusterer,
 ) -> (Vec<bool>, Vec<bool>, bool) {
     let mut taken = vec![false; q.len()];
     let mut inner = vec![false; q.len()];
@@ -204,7 +217,7 @@ fn grow(
             }
         }
         if !near.is_empty() && !ring.is_empty() {
-            let (comp, sizes) = clusters(&near, along);
+            let (comp, sizes) = clusterer.clusters(&near, along);
             let mut hit = vec![false; sizes.len()];
             for &r in &ring {
                 hit[comp[r as usize] as usize] = true;

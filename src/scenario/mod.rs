@@ -145,9 +145,11 @@ impl Scenario {
         let te = clock::now_ms();
         if p.expansion && !self.primitives.is_empty() && n > 0 {
             let mut index = ScanIndex::new(&cloud.points, INDEX_VOXEL);
+            let mut scratch = expand::Scratch::default();
             for (k, prim) in self.primitives.iter_mut().enumerate() {
                 let stamp = k as u32 + 1;
                 let taken = expand::expand(
+                    &mut scratch,
                     prim,
                     cloud,
                     &mut index,
