@@ -225,7 +225,15 @@ pub fn voxelise(pts: &[glam::Vec3], voxel: f64) -> Voxels {
     );
     let mut finite = true;
     for p in pts {
-        crate::geometry::grow_box(&mut plo, &mut phi, *p);
+        // f32 comparisons per lane (f32::min/max are library calls in wasm).
+        for k in 0..3 {
+            if p[k] < plo[k] {
+                plo[k] = p[k];
+            }
+            if p[k] > phi[k] {
+                phi[k] = p[k];
+            }
+        }
         finite &= p.is_finite();
     }
     let (lo, hi) = (coord(&plo), coord(&phi));

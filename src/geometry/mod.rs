@@ -63,16 +63,3 @@ impl BoxCoords for glam::DVec3 {
         self[k] = v;
     }
 }
-
-impl BoxCoords for glam::Vec3 {
-    const DIM: usize = 3;
-    #[inline]
-    fn get(&self, k: usize) -> f64 {
-        self[k] as f64
-    }
-    #[inline]
-    fn set(&mut self, k: usize, v: f64) {
-        // Exact: v is one of the f32 coordinates.
-        self[k] = v as f32;
-    }
-}
