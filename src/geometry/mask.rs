@@ -71,7 +71,7 @@ impl GrownMask {
                     xs.push(a.x + (y - a.y) * (b.x - a.x) / (b.y - a.y));
                 }
             }
-            xs.sort_by(f64::total_cmp);
+            super::insertion_sort_by(&mut xs, f64::total_cmp);
             for pair in xs.chunks_exact(2) {
                 let c0 = ((pair[0] - origin.x) / cell - 0.5).ceil().max(0.0) as usize;
                 let c1 = ((pair[1] - origin.x) / cell - 0.5).floor();

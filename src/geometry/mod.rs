@@ -63,3 +63,22 @@ impl BoxCoords for glam::DVec3 {
         self[k] = v;
     }
 }
+
+/// Stable insertion sort: for the short lists (scan-line crossings, three
+/// eigenvalues, a sensor's rings) that would otherwise each instantiate the
+/// standard library's sort, several kilobytes of wasm apiece. Same order as
+/// `sort_by` with the same comparison.
+pub(crate) fn insertion_sort_by<T: Copy>(
+    v: &mut [T],
+    mut cmp: impl FnMut(&T, &T) -> std::cmp::Ordering,
+) {
+    for i in 1..v.len() {
+        let x = v[i];
+        let mut j = i;
+        while j > 0 && cmp(&v[j - 1], &x) == std::cmp::Ordering::Greater {
+            v[j] = v[j - 1];
+            j -= 1;
+        }
+        v[j] = x;
+    }
+}

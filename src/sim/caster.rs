@@ -409,7 +409,7 @@ fn poly_column(
         return;
     }
     if xs.len() > 2 {
-        xs.sort_by(|a, b| a.0.total_cmp(&b.0));
+        crate::geometry::insertion_sort_by(xs, |a, b| a.0.total_cmp(&b.0));
     }
     let nr = normal.x * c + normal.y * s;
     let nz = normal.z;

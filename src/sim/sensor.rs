@@ -212,7 +212,7 @@ impl Beams {
             .collect();
         let mut order: Vec<usize> = (0..el.len()).collect();
         // Descending elevation; ties keep output order (stable sort).
-        order.sort_by(|&a, &b| el[b].total_cmp(&el[a]));
+        crate::geometry::insertion_sort_by(&mut order, |&a, &b| el[b].total_cmp(&el[a]));
         let mut rank = vec![0; el.len()];
         for (k, &l) in order.iter().enumerate() {
             rank[l] = k;
