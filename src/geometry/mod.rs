@@ -82,3 +82,19 @@ pub(crate) fn insertion_sort_by<T: Copy>(
         v[j] = x;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn insertion_sort_is_stable_and_matches_sort_by() {
+        let mut rng = crate::rng::Rng::new(4);
+        for n in [0, 1, 2, 3, 17, 130] {
+            // Few distinct keys, so ties are common; the index shows order.
+            let v: Vec<(f64, usize)> = (0..n).map(|i| (rng.below(5) as f64, i)).collect();
+            let (mut a, mut b) = (v.clone(), v);
+            super::insertion_sort_by(&mut a, |x, y| x.0.total_cmp(&y.0));
+            b.sort_by(|x, y| x.0.total_cmp(&y.0));
+            assert_eq!(a, b, "n = {n}");
+        }
+    }
+}
