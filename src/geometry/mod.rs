@@ -20,48 +20,28 @@ pub use polygon::Polygon3;
 #[inline]
 pub(crate) fn grow_box<T: BoxCoords>(lo: &mut T, hi: &mut T, p: T) {
     for k in 0..T::DIM {
-        let v = p.get(k);
-        if v < lo.get(k) {
-            lo.set(k, v);
+        let v = p[k];
+        if v < lo[k] {
+            lo[k] = v;
         }
-        if v > hi.get(k) {
-            hi.set(k, v);
+        if v > hi[k] {
+            hi[k] = v;
         }
     }
 }
 
-/// Points [`grow_box`] works on.
-pub(crate) trait BoxCoords: Copy {
+/// Points [`grow_box`] works on: f64 coordinates by index.
+pub(crate) trait BoxCoords: Copy + std::ops::IndexMut<usize, Output = f64> {
     /// Number of coordinates.
     const DIM: usize;
-    /// Coordinate `k` (as f64).
-    fn get(&self, k: usize) -> f64;
-    /// Set coordinate `k`.
-    fn set(&mut self, k: usize, v: f64);
 }
 
 impl BoxCoords for glam::DVec2 {
     const DIM: usize = 2;
-    #[inline]
-    fn get(&self, k: usize) -> f64 {
-        self[k]
-    }
-    #[inline]
-    fn set(&mut self, k: usize, v: f64) {
-        self[k] = v;
-    }
 }
 
 impl BoxCoords for glam::DVec3 {
     const DIM: usize = 3;
-    #[inline]
-    fn get(&self, k: usize) -> f64 {
-        self[k]
-    }
-    #[inline]
-    fn set(&mut self, k: usize, v: f64) {
-        self[k] = v;
-    }
 }
 
 /// Stable insertion sort: for the short lists (scan-line crossings, three
