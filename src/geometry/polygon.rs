@@ -165,6 +165,10 @@ fn edges_by_cell(ring: &[DVec2]) -> Option<(Vec<u32>, Vec<u32>)> {
     }
     let g = ((n as f64).sqrt().ceil() as usize).max(1);
     let size = (hi - lo) / g as f64;
+    if !size.is_finite() {
+        // Coordinates so far apart that their difference overflows.
+        return None;
+    }
     // Monotone in the coordinate, so a point on two edges' boxes maps to a
     // cell inside both edges' cell ranges.
     let index = |v: f64, lo: f64, size: f64| -> usize {
@@ -545,6 +549,15 @@ mod tests {
             }
         }
         assert!(simple > 100 && not > 100, "{simple} simple, {not} not");
+        // Extreme coordinates: the bucket grid cannot span them; the answer
+        // must still be right.
+        let far: Vec<DVec2> = (0..40)
+            .map(|k| {
+                let t = k as f64 / 40.0 * std::f64::consts::TAU;
+                DVec2::new(1e308 * t.cos(), 1e308 * t.sin())
+            })
+            .collect();
+        assert_eq!(is_simple(&far), is_simple_brute_force(&far));
     }
 
     fn square(s: f64) -> Vec<DVec2> {
