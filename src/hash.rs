@@ -141,6 +141,90 @@ impl Buckets {
     }
 }
 
+/// First-seen ids of 2D grid cells, looked up in a dense array over the
+/// cells' box when it holds at most `4 * points + extra` cells (the usual
+/// case), else in a hash map; either way ids come in first-seen order, so
+/// results never depend on the choice. The buffers are kept between calls
+/// (the dense array is cleared cell by cell, not refilled).
+#[derive(Default)]
+pub struct CellIds {
+    /// `ids[(y - lo.1) * w + (x - lo.0)]`, `u32::MAX` when empty.
+    ids: Vec<u32>,
+    map: GridMap<u64, u32>,
+    dense: bool,
+    lo: (i64, i64),
+    w: usize,
+    h: usize,
+    /// Cell coordinates of each id.
+    pub keys: Vec<(i64, i64)>,
+}
+
+impl CellIds {
+    /// Number ids for the cells `xy` (one per point), writing each point's
+    /// cell id into `cell_of` (cleared first). `extra` sets how large an
+    /// empty box still gets the dense array.
+    pub fn assign(&mut self, xy: &[(i64, i64)], extra: u128, cell_of: &mut Vec<u32>) {
+        // Leave the dense array all-empty from the previous call.
+        if self.dense {
+            for &(x, y) in &self.keys {
+                self.ids[(y - self.lo.1) as usize * self.w + (x - self.lo.0) as usize] = u32::MAX;
+            }
+        }
+        self.keys.clear();
+        cell_of.clear();
+        let (mut lo, mut hi) = ((i64::MAX, i64::MAX), (i64::MIN, i64::MIN));
+        for &(x, y) in xy {
+            lo = (lo.0.min(x), lo.1.min(y));
+            hi = (hi.0.max(x), hi.1.max(y));
+        }
+        let (w, h) = (
+            (hi.0 as i128 - lo.0 as i128 + 1).max(0) as u128,
+            (hi.1 as i128 - lo.1 as i128 + 1).max(0) as u128,
+        );
+        self.dense = !xy.is_empty() && w * h <= 4 * xy.len() as u128 + extra;
+        if self.dense {
+            (self.lo, self.w, self.h) = (lo, w as usize, h as usize);
+            if self.ids.len() < self.w * self.h {
+                self.ids.resize(self.w * self.h, u32::MAX);
+            }
+            for &(x, y) in xy {
+                let k = (y - lo.1) as usize * self.w + (x - lo.0) as usize;
+                if self.ids[k] == u32::MAX {
+                    self.ids[k] = self.keys.len() as u32;
+                    self.keys.push((x, y));
+                }
+                cell_of.push(self.ids[k]);
+            }
+        } else {
+            self.map.clear();
+            for &(x, y) in xy {
+                let next = self.keys.len() as u32;
+                let id = *self.map.entry(key2(x, y)).or_insert(next);
+                if id == next {
+                    self.keys.push((x, y));
+                }
+                cell_of.push(id);
+            }
+        }
+    }
+
+    /// Id of the cell `(x, y)` of the last [`CellIds::assign`], if it had
+    /// points.
+    #[inline]
+    pub fn get(&self, x: i64, y: i64) -> Option<u32> {
+        if self.dense {
+            let (dx, dy) = (x.wrapping_sub(self.lo.0), y.wrapping_sub(self.lo.1));
+            if dx < 0 || dy < 0 || dx as usize >= self.w || dy as usize >= self.h {
+                return None;
+            }
+            let id = self.ids[dy as usize * self.w + dx as usize];
+            (id != u32::MAX).then_some(id)
+        } else {
+            self.map.get(&key2(x, y)).copied()
+        }
+    }
+}
+
 /// Points assigned to cubic voxels (see [`voxelise`]).
 pub struct Voxels {
     /// Voxel id of each point; ids in first-seen order.
@@ -292,6 +376,30 @@ pub fn voxelise(pts: &[glam::Vec3], voxel: f64) -> Voxels {
 mod tests {
     use super::{floor_i64, voxelise, Buckets, VoxelIds};
     use glam::Vec3;
+
+    #[test]
+    fn dense_and_hashed_cell_ids_agree() {
+        // The same cells numbered through the dense array (extra room) and
+        // the map (none), twice with one instance to check it resets.
+        let xy: Vec<(i64, i64)> = [(3, 4), (3, 4), (-2, 9), (100, -7), (3, 4), (-2, 9)].to_vec();
+        let other: Vec<(i64, i64)> = [(50, 50), (0, 0), (50, 50)].to_vec();
+        let (mut dense, mut hashed) = (super::CellIds::default(), super::CellIds::default());
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        for cells in [&xy, &other, &xy] {
+            dense.assign(cells, 1 << 20, &mut a);
+            hashed.assign(cells, 0, &mut b);
+            assert_eq!(a, b);
+            assert_eq!(dense.keys, hashed.keys);
+            for (id, &(x, y)) in dense.keys.iter().enumerate() {
+                assert_eq!(dense.get(x, y), Some(id as u32));
+                assert_eq!(hashed.get(x, y), Some(id as u32));
+            }
+            for (x, y) in [(1000, 1000), (i64::MIN, i64::MAX), (4, 3)] {
+                assert_eq!((dense.get(x, y), hashed.get(x, y)), (None, None));
+            }
+        }
+        assert_eq!(a, vec![0, 0, 1, 2, 0, 1]);
+    }
 
     #[test]
     fn dense_and_hashed_voxels_agree() {

@@ -184,50 +184,26 @@ fn normal_consistency(
 ) -> f64 {
     // Large supports are judged on an even-strided subsample of 100k points.
     let step = pts.len().div_ceil(100_000).max(1);
-    let chosen = || {
-        (0..pts.len()).step_by(step).filter(|&i| kept[i]).map(|i| {
-            let key = (
+    let chosen: Vec<usize> = (0..pts.len()).step_by(step).filter(|&i| kept[i]).collect();
+    let xy: Vec<(i64, i64)> = chosen
+        .iter()
+        .map(|&i| {
+            (
                 crate::hash::floor_i64(q[i].x / cell),
                 crate::hash::floor_i64(q[i].y / cell),
-            );
-            (i, key)
+            )
         })
-    };
-    // Patch ids in first-seen order, through a dense array over the
-    // patches' box when it is small (the usual case), else a map; each
-    // patch's moments gather its points in input order either way.
-    let (mut lo, mut hi) = ((i64::MAX, i64::MAX), (i64::MIN, i64::MIN));
-    let mut n = 0usize;
-    for (_, (x, y)) in chosen() {
-        lo = (lo.0.min(x), lo.1.min(y));
-        hi = (hi.0.max(x), hi.1.max(y));
-        n += 1;
-    }
-    let mut cells: Vec<Moments> = Vec::new();
-    let span = (hi.0 as i128 - lo.0 as i128 + 1) * (hi.1 as i128 - lo.1 as i128 + 1);
-    if n > 0 && span <= 4 * n as i128 + (1 << 16) {
-        let gw = (hi.0 - lo.0 + 1) as usize;
-        let mut ids = vec![0u32; span as usize];
-        for (i, (x, y)) in chosen() {
-            let k = (y - lo.1) as usize * gw + (x - lo.0) as usize;
-            let w = origin + pts[i].as_dvec3();
-            if ids[k] == 0 {
-                cells.push(Moments::new(w));
-                ids[k] = cells.len() as u32;
-            }
-            cells[ids[k] as usize - 1].push(w);
+        .collect();
+    // Patches in first-seen order, each gathering its points in input order.
+    let (mut ids, mut patch_of) = (crate::hash::CellIds::default(), Vec::new());
+    ids.assign(&xy, 1 << 16, &mut patch_of);
+    let mut cells: Vec<Moments> = Vec::with_capacity(ids.keys.len());
+    for (&i, &c) in chosen.iter().zip(&patch_of) {
+        let w = origin + pts[i].as_dvec3();
+        if c as usize == cells.len() {
+            cells.push(Moments::new(w));
         }
-    } else {
-        let mut ids: crate::hash::GridMap<u64, u32> = crate::hash::GridMap::default();
-        for (i, (x, y)) in chosen() {
-            let w = origin + pts[i].as_dvec3();
-            let next = cells.len() as u32;
-            let id = *ids.entry(crate::hash::key2(x, y)).or_insert(next);
-            if id == next {
-                cells.push(Moments::new(w));
-            }
-            cells[id as usize].push(w);
-        }
+        cells[c as usize].push(w);
     }
     let (mut good, mut total) = (0usize, 0usize);
     let cos_max = libm::cos(15f64.to_radians());

@@ -7,7 +7,7 @@
 //! than `tol`; only cells whose boxes are closer than `tol` are compared (a
 //! 5x5 neighbourhood), and the comparison stops at the first close pair.
 
-use crate::hash::{floor_i64, key2, Buckets, GridMap};
+use crate::hash::{floor_i64, Buckets, CellIds};
 use glam::DVec2;
 
 /// Indices of the points in the largest cluster (ties: the cluster holding
@@ -47,9 +47,7 @@ const DENSE_CELLS: u128 = 1 << 21;
 #[derive(Default)]
 pub struct Clusterer {
     cell_xy: Vec<(i64, i64)>,
-    ids: Vec<u32>,
-    map: GridMap<u64, u32>,
-    cell_key: Vec<(i64, i64)>,
+    ids: CellIds,
     cell_of: Vec<u32>,
     buckets: Buckets,
     bbox: Vec<[f64; 4]>,
@@ -71,65 +69,16 @@ impl Clusterer {
         };
         let side = tol / std::f64::consts::SQRT_2;
         let inv = 1.0 / side;
-        // Cell coordinates, once per point.
+        // Cell coordinates, once per point, then ids in first-seen order.
         self.cell_xy.clear();
-        let (mut lo, mut hi) = ((i64::MAX, i64::MAX), (i64::MIN, i64::MIN));
-        for p in points {
-            let c = (floor_i64(p.x * inv), floor_i64(p.y * inv));
-            lo = (lo.0.min(c.0), lo.1.min(c.1));
-            hi = (hi.0.max(c.0), hi.1.max(c.1));
-            self.cell_xy.push(c);
-        }
-        // Cell ids in first-seen order; looked up in a dense array when the
-        // bounding box is small enough (the usual case), else in a hash map.
-        let (gw, gh) = (
-            (hi.0 as i128 - lo.0 as i128 + 1) as u128,
-            (hi.1 as i128 - lo.1 as i128 + 1) as u128,
+        self.cell_xy.extend(
+            points
+                .iter()
+                .map(|p| (floor_i64(p.x * inv), floor_i64(p.y * inv))),
         );
-        let dense = gw * gh <= 4 * n as u128 + DENSE_CELLS;
-        let (gw, gh) = if dense {
-            (gw as usize, gh as usize)
-        } else {
-            (0, 0)
-        };
-        self.cell_key.clear();
-        self.cell_of.clear();
-        if dense {
-            if self.ids.len() < gw * gh {
-                self.ids.resize(gw * gh, u32::MAX);
-            }
-            for &(cx, cy) in &self.cell_xy {
-                let k = (cy - lo.1) as usize * gw + (cx - lo.0) as usize;
-                if self.ids[k] == u32::MAX {
-                    self.ids[k] = self.cell_key.len() as u32;
-                    self.cell_key.push((cx, cy));
-                }
-                self.cell_of.push(self.ids[k]);
-            }
-        } else {
-            self.map.clear();
-            for &(cx, cy) in &self.cell_xy {
-                let next = self.cell_key.len() as u32;
-                let id = *self.map.entry(key2(cx, cy)).or_insert(next);
-                if id == next {
-                    self.cell_key.push((cx, cy));
-                }
-                self.cell_of.push(id);
-            }
-        }
-        let lookup = |ids: &[u32], map: &GridMap<u64, u32>, x: i64, y: i64| -> Option<u32> {
-            if dense {
-                let (dx, dy) = (x.wrapping_sub(lo.0), y.wrapping_sub(lo.1));
-                if dx < 0 || dy < 0 || dx as usize >= gw || dy as usize >= gh {
-                    return None;
-                }
-                let id = ids[dy as usize * gw + dx as usize];
-                (id != u32::MAX).then_some(id)
-            } else {
-                map.get(&key2(x, y)).copied()
-            }
-        };
-        let cells = self.cell_key.len();
+        self.ids
+            .assign(&self.cell_xy, DENSE_CELLS, &mut self.cell_of);
+        let cells = self.ids.keys.len();
         // Points per cell, and each cell's bounding box.
         self.buckets.fill(&self.cell_of, cells);
         self.bbox.clear();
@@ -187,15 +136,10 @@ impl Clusterer {
         let tol2 = tol * tol;
         let (parent, near) = (&mut self.parent, &mut self.near);
         for c in 0..cells {
-            let (cx, cy) = self.cell_key[c];
+            let (cx, cy) = self.ids.keys[c];
             let a = self.buckets.of(c);
             for &(dx, dy) in &offsets {
-                let Some(nb) = lookup(
-                    &self.ids,
-                    &self.map,
-                    cx.wrapping_add(dx),
-                    cy.wrapping_add(dy),
-                ) else {
+                let Some(nb) = self.ids.get(cx.wrapping_add(dx), cy.wrapping_add(dy)) else {
                     continue;
                 };
                 let (ra, rb) = (find(parent, c as u32), find(parent, nb));
@@ -239,13 +183,6 @@ impl Clusterer {
                     let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
                     parent[hi as usize] = lo;
                 }
-            }
-        }
-        // Leave the dense id array all-empty for the next call (only the
-        // cells used here were set).
-        if dense {
-            for &(cx, cy) in &self.cell_key {
-                self.ids[(cy - lo.1) as usize * gw + (cx - lo.0) as usize] = u32::MAX;
             }
         }
         // Roots once per cell, then per point a lookup.
