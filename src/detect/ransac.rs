@@ -97,10 +97,9 @@ impl<'a> PlanePool<'a> {
     /// All of `pts` in play, shuffled once with `rng`.
     pub fn new(pts: &'a [Vec3], sample_radius: f64, mut rng: Rng) -> Self {
         let n = pts.len();
-        // A uniform random subset of at most POOL_CAP points in random order
-        // (the first steps of a Fisher-Yates shuffle): every prefix is a
+        // The scoring pool: every point in random order, or beyond POOL_CAP
+        // points a uniform random subset of POOL_CAP; every prefix is a
         // uniform random subsample, which is all the scoring needs.
-        let m = n.min(POOL_CAP);
         let mut order: Vec<u32> = (0..n as u32).collect();
         if n <= POOL_CAP {
             for i in (1..n).rev() {
@@ -108,32 +107,13 @@ impl<'a> PlanePool<'a> {
                 order.swap(i, j);
             }
         } else {
-            for i in 0..m {
-                let j = i + rng.below(n - i);
-                order.swap(i, j);
-            }
-            order.truncate(m);
-        }
-        let (mut rx, mut ry, mut rz) = (
-            Vec::with_capacity(m),
-            Vec::with_capacity(m),
-            Vec::with_capacity(m),
-        );
-        for &i in &order {
-            let p = pts[i as usize];
-            rx.push(p.x);
-            ry.push(p.y);
-            rz.push(p.z);
+            random_prefix(&mut order, POOL_CAP, &mut rng);
         }
         // Sampling voxels (ids in first-seen order of the original indices).
         let voxels = crate::hash::voxelise(pts, sample_radius.max(1e-3));
         let cells = voxels.coords.len();
         let cell_of = voxels.cell_of;
         let buckets = Buckets::new(&cell_of, cells);
-        let mut pos_of = vec![u32::MAX; n];
-        for (pos, &i) in order.iter().enumerate() {
-            pos_of[i as usize] = pos as u32;
-        }
         let cell_pts: Vec<Vec3> = buckets.items.iter().map(|&i| pts[i as usize]).collect();
         let mut cell_pos_of = vec![0u32; n];
         for (pos, &i) in buckets.items.iter().enumerate() {
@@ -152,25 +132,27 @@ impl<'a> PlanePool<'a> {
             cell_box.push(((lo + hi) * 0.5, (hi - lo) * 0.5));
             cell_live.push(members.len() as u32);
         }
-        PlanePool {
-            pool_live: m,
+        let mut pool = PlanePool {
+            pool_live: 0,
             cell_pts,
             cell_pos_of,
             cell_box,
             cell_live,
             live: n,
-            pos_of,
+            pos_of: vec![u32::MAX; n],
             pts,
             alive: vec![true; n],
-            rx,
-            ry,
-            rz,
-            ridx: order,
+            rx: Vec::new(),
+            ry: Vec::new(),
+            rz: Vec::new(),
+            ridx: Vec::new(),
             cell_of,
             voxels: buckets,
             rng,
             work: 0,
-        }
+        };
+        pool.set_pool(order);
+        pool
     }
 
     /// Number of points still in play.
@@ -187,13 +169,12 @@ impl<'a> PlanePool<'a> {
         let mut order: Vec<u32> = (0..self.pts.len() as u32)
             .filter(|&i| self.alive[i as usize])
             .collect();
-        let n = order.len();
-        let m = n.min(POOL_CAP);
-        for i in 0..m {
-            let j = i + self.rng.below(n - i);
-            order.swap(i, j);
-        }
-        order.truncate(m);
+        random_prefix(&mut order, POOL_CAP, &mut self.rng);
+        self.set_pool(order);
+    }
+
+    /// Make these (live, original) indices the scoring pool, in this order.
+    fn set_pool(&mut self, order: Vec<u32>) {
         self.rx.clear();
         self.ry.clear();
         self.rz.clear();
@@ -204,8 +185,8 @@ impl<'a> PlanePool<'a> {
             self.rz.push(p.z);
             self.pos_of[i as usize] = pos as u32;
         }
+        self.pool_live = order.len();
         self.ridx = order;
-        self.pool_live = m;
     }
 
     /// Take these original indices out of play. Their coordinates in the
@@ -488,12 +469,10 @@ impl<'a> PlanePool<'a> {
             if (plane.normal.dot(centre) + plane.offset).abs() > reach {
                 continue;
             }
-            let (lo, hi) = (
-                self.voxels.start[c] as usize,
-                self.voxels.start[c + 1] as usize,
-            );
-            self.work += (hi - lo) as u64;
-            for (k, p) in self.cell_pts[lo..hi].iter().enumerate() {
+            let range = self.voxels.range(c);
+            let lo = range.start;
+            self.work += range.len() as u64;
+            for (k, p) in self.cell_pts[range].iter().enumerate() {
                 let v = nx * p.x + ny * p.y + nz * p.z + d;
                 if v.abs() < t {
                     out.push(self.voxels.items[lo + k]);
@@ -585,6 +564,18 @@ impl<'a> PlanePool<'a> {
             threshold: 0.0,
         })
     }
+}
+
+/// Keep a uniform random subset of at most `m` of `order`, in random order
+/// (the first steps of a Fisher-Yates shuffle).
+fn random_prefix(order: &mut Vec<u32>, m: usize, rng: &mut Rng) {
+    let n = order.len();
+    let m = n.min(m);
+    for i in 0..m {
+        let j = i + rng.below(n - i);
+        order.swap(i, j);
+    }
+    order.truncate(m);
 }
 
 /// Hypotheses needed so that an all-inlier sample (probability `p` each) was
