@@ -685,8 +685,13 @@ impl BitGrid {
     /// From one bool per cell, row-major.
     pub(crate) fn from_bools(cells: &[bool], w: usize, h: usize) -> Self {
         let mut g = BitGrid::new(w, h);
-        for (k, _) in cells.iter().enumerate().take(w * h).filter(|(_, &c)| c) {
-            g.set(k % w, k / w);
+        if w == 0 {
+            return g;
+        }
+        for (y, row) in cells.chunks(w).take(h).enumerate() {
+            for (x, _) in row.iter().enumerate().filter(|(_, &c)| c) {
+                g.set(x, y);
+            }
         }
         g
     }
