@@ -1,16 +1,23 @@
 //! RANSAC plane search over the points still unexplained, built to find the
-//! same plane plain RANSAC would (the largest consensus set) with far less
-//! work:
+//! plane an exhaustive MSAC search would (the best soft consensus, below)
+//! with far less work:
 //!
 //! - **Local sampling.** The first point of a hypothesis is drawn uniformly;
 //!   the other two from the same voxel of side `sample_radius`, so one sample
 //!   rarely mixes two surfaces (Schnabel et al.'s locality argument). Plain
 //!   uniform triples hit a 5 % wall with probability 1.25e-4; local ones with
 //!   roughly 5 % x 1/4.
+//! - **MSAC scores.** A hypothesis scores `1 - (d/t)^2` for each point at
+//!   distance `d < t` (Torr and Zisserman's truncated quadratic loss, as a
+//!   soft inlier count), not 1 per inlier. With plain counts a plane tilted
+//!   by half a degree across a road and the strip of sidewalk its slab
+//!   reaches wins over the road's own plane (it holds more points, fitted
+//!   far worse); the support it gathers is rough and rejected, and a whole
+//!   location's road went with it. Soft scores rank the road's plane first.
 //! - **Scoring on a subsample.** The remaining points are kept in one fixed
 //!   random order, so any prefix is a uniform random subsample. Hypotheses are
 //!   scored on a prefix of `k` points (4096 to start); when even the best
-//!   scores too few subsample inliers to be ranked reliably (< 40), `k` grows
+//!   scores too few subsample inliers to be ranked reliably (soft score < 40), `k` grows
 //!   fourfold and the search restarts, up to all points.
 //! - **Local test.** A hypothesis must explain at least 30 % of the live
 //!   points of the voxel it was sampled in, or it mixed two surfaces or came
@@ -23,8 +30,9 @@
 //!   `[24, max_hypotheses]`.
 //! - **Local optimisation and confirmation.** The best hypothesis is refit
 //!   by robust least squares (f64 PCA, trimmed) on its inliers among a
-//!   random subsample of at most 16 384 points, and the refined plane is
-//!   counted once on all remaining points.
+//!   random subsample of at most 16 384 points; it replaces the hypothesis
+//!   when it scores at least as well there (with the same threshold), and
+//!   its inliers are then collected once from all remaining points.
 //!
 //! Bounds on work per primitive: at most `max_hypotheses * k` distance
 //! evaluations per prefix size (and at most `4 * max_hypotheses` samples), prefix sizes grow geometrically to `n`, plus
@@ -267,7 +275,7 @@ impl<'a> PlanePool<'a> {
         };
         let mut k = n.min(START_K);
         let best = loop {
-            let mut best: Option<(LocalPlane, usize)> = None;
+            let mut best: Option<(LocalPlane, f64)> = None;
             let mut needed = params.max_hypotheses;
             let (mut t, mut attempts) = (0, 0);
             while t < needed.min(params.max_hypotheses) && attempts < 4 * params.max_hypotheses {
@@ -286,15 +294,15 @@ impl<'a> PlanePool<'a> {
                     continue;
                 }
                 t += 1;
-                let score = self.score_prefix(&plane, k, best.map_or(0, |b| b.1));
+                let score = self.score_prefix(&plane, k, best.map_or(0.0, |b| b.1));
                 if best.is_none_or(|b| score > b.1) {
                     best = Some((plane, score));
-                    let w = score as f64 / k as f64;
+                    let w = score / k as f64;
                     needed = hypotheses_needed(w * 0.5, params.confidence);
                 }
             }
             let best = best?;
-            if best.1 < MIN_RANKABLE && k < n {
+            if best.1 < MIN_RANKABLE as f64 && k < n {
                 k = n.min(k * 4);
                 continue;
             }
@@ -312,11 +320,14 @@ impl<'a> PlanePool<'a> {
                     threshold: threshold_for(refit.normal, refit.offset),
                     ..refit
                 };
-                // The least-squares plane beats a three-point plane; keep it
-                // unless it explains clearly fewer points.
-                self.work += lo_k as u64;
-                let again = self.count(&refit, 0, lo_k);
-                if 10 * again >= 9 * sample.len() {
+                // Keep the refit when it scores at least as well on the
+                // subsample, both scored with the hypothesis's threshold.
+                self.work += 2 * lo_k as u64;
+                let same_t = LocalPlane {
+                    threshold: best.threshold,
+                    ..refit
+                };
+                if self.count(&same_t, 0, lo_k) >= self.count(&best, 0, lo_k) {
                     plane = refit;
                 }
             }
@@ -402,38 +413,43 @@ impl<'a> PlanePool<'a> {
         Some((nrm, -nrm.dot(p1), c))
     }
 
-    fn count(&self, plane: &LocalPlane, lo: usize, hi: usize) -> usize {
+    /// MSAC score of `plane` over pool entries `lo..hi`: each point within
+    /// the threshold counts `1 - (d/t)^2`, others (and dead entries) 0. A
+    /// soft inlier count: a plane through the middle of a surface scores
+    /// close to its inlier count, one tilted across two surfaces far less.
+    fn count(&self, plane: &LocalPlane, lo: usize, hi: usize) -> f64 {
         let (nx, ny, nz) = (
             plane.normal.x as f32,
             plane.normal.y as f32,
             plane.normal.z as f32,
         );
-        let (d, t) = (plane.offset as f32, plane.threshold as f32);
+        let (d, inv) = (plane.offset as f32, (1.0 / plane.threshold) as f32);
         let (xs, ys, zs) = (&self.rx[lo..hi], &self.ry[lo..hi], &self.rz[lo..hi]);
-        // Eight independent lanes with u32 counters: this shape vectorises.
-        let mut acc = [0u32; 8];
+        let mut acc = [0f32; 8];
         let (cx, cy, cz) = (xs.chunks_exact(8), ys.chunks_exact(8), zs.chunks_exact(8));
         let (tx, ty, tz) = (cx.remainder(), cy.remainder(), cz.remainder());
         for ((x, y), z) in cx.zip(cy).zip(cz) {
             for l in 0..8 {
-                let v = nx * x[l] + ny * y[l] + nz * z[l] + d;
-                acc[l] += (v.abs() < t) as u32;
+                let v = (nx * x[l] + ny * y[l] + nz * z[l] + d) * inv;
+                let w = 1.0 - v * v;
+                acc[l] += if w > 0.0 { w } else { 0.0 };
             }
         }
-        let mut c: usize = acc.iter().map(|&a| a as usize).sum();
+        let mut c: f64 = acc.iter().map(|&a| a as f64).sum();
         for i in 0..tx.len() {
-            let v = nx * tx[i] + ny * ty[i] + nz * tz[i] + d;
-            c += (v.abs() < t) as usize;
+            let v = (nx * tx[i] + ny * ty[i] + nz * tz[i] + d) * inv;
+            let w = 1.0 - v * v;
+            c += (if w > 0.0 { w } else { 0.0 }) as f64;
         }
         c
     }
 
-    fn score_prefix(&mut self, plane: &LocalPlane, k: usize, best: usize) -> usize {
+    fn score_prefix(&mut self, plane: &LocalPlane, k: usize, best: f64) -> f64 {
         let head = k / 8;
         let c1 = self.count(plane, 0, head);
-        if best > 0 && head > 0 && c1 * 8 * 2 < best {
+        if best > 0.0 && head > 0 && c1 * 16.0 < best {
             self.work += head as u64;
-            return c1 * 8;
+            return c1 * 8.0;
         }
         self.work += k as u64;
         c1 + self.count(plane, head, k)
