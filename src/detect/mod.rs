@@ -125,7 +125,7 @@ impl<'p> Detector<'p> {
             let ts = clock::now_ms();
             let points_left = pool.remaining();
             // 1. RANSAC: the plane with the largest consensus, or stop.
-            let Some((plane, inliers)) = pool.best_plane(p, viewpoint - origin) else {
+            let Some((plane, inliers, coords)) = pool.best_plane(p, viewpoint - origin) else {
                 break;
             };
             // 2. Cluster the inliers in the plane; the largest cluster is the support.
@@ -133,10 +133,10 @@ impl<'p> Detector<'p> {
                 normal: plane.normal,
                 offset: plane.offset,
             };
-            let frame = Frame::on_plane(&local, pts[inliers[0] as usize].as_dvec3());
-            let flat: Vec<DVec2> = inliers
+            let frame = Frame::on_plane(&local, coords[0].as_dvec3());
+            let flat: Vec<DVec2> = coords
                 .iter()
-                .map(|&i| frame.to_local(pts[i as usize].as_dvec3()))
+                .map(|p| frame.to_local(p.as_dvec3()))
                 .collect();
             let (comp, sizes) = clusterer.clusters(&flat, p.cluster_tolerance);
             let largest = comp
@@ -167,11 +167,13 @@ impl<'p> Detector<'p> {
                 rejections += 1;
                 continue;
             }
-            let cluster: Vec<u32> = (0..comp.len())
-                .filter(|&c| comp[c] == largest)
-                .map(|c| inliers[c])
-                .collect();
-            let support_pts: Vec<Vec3> = cluster.iter().map(|&i| pts[i as usize]).collect();
+            let (mut cluster, mut support_pts) = (Vec::new(), Vec::new());
+            for (c, &l) in comp.iter().enumerate() {
+                if l == largest {
+                    cluster.push(inliers[c]);
+                    support_pts.push(coords[c]);
+                }
+            }
             // 3-4. PCA refit, frame, outline, area and solidity.
             let shaped = shape(origin, &support_pts, p, viewpoint);
             // 5. Accept when large and solid enough.

@@ -240,16 +240,16 @@ impl<'a> PlanePool<'a> {
         self.rz.truncate(w);
     }
 
-    /// The plane with the largest consensus among the remaining points and
-    /// its inliers (original indices), or `None` when no plane has
-    /// `min_inliers`.
+    /// The plane with the largest consensus among the remaining points, its
+    /// inliers (original indices) and their coordinates, or `None` when no
+    /// plane has `min_inliers`.
     /// `viewpoint` is the sensor in local coordinates: horizontal planes at
     /// least `ground_depth` below it are counted with the ground distance.
     pub fn best_plane(
         &mut self,
         params: &Params,
         viewpoint: DVec3,
-    ) -> Option<(LocalPlane, Vec<u32>)> {
+    ) -> Option<(LocalPlane, Vec<u32>, Vec<Vec3>)> {
         if self.remaining() < params.min_inliers.max(3) {
             return None;
         }
@@ -332,11 +332,11 @@ impl<'a> PlanePool<'a> {
                 }
             }
         }
-        let inliers = self.collect(&plane);
+        let (inliers, coords) = self.collect(&plane);
         if inliers.len() < params.min_inliers.max(3) {
             return None;
         }
-        Some((plane, inliers))
+        Some((plane, inliers, coords))
     }
 
     /// Do at least 30 % of the live points of voxel `cell` lie on `plane`?
@@ -461,11 +461,13 @@ impl<'a> PlanePool<'a> {
         self.inliers_in(plane, k)
     }
 
-    /// All inliers of `plane` (original indices, in voxel order). Only the
+    /// All inliers of `plane` (original indices, in voxel order) and their
+    /// coordinates (read here in voxel order anyway; gathering them again
+    /// by index afterwards costs a cache miss a point). Only the
     /// voxels whose point box reaches within the threshold of the plane are
     /// read: a plane's slab crosses a small share of a street's voxels, so
     /// this costs far less than a pass over every remaining point.
-    fn collect(&mut self, plane: &LocalPlane) -> Vec<u32> {
+    fn collect(&mut self, plane: &LocalPlane) -> (Vec<u32>, Vec<Vec3>) {
         let (nx, ny, nz) = (
             plane.normal.x as f32,
             plane.normal.y as f32,
@@ -473,7 +475,7 @@ impl<'a> PlanePool<'a> {
         );
         let (d, t) = (plane.offset as f32, plane.threshold as f32);
         let an = plane.normal.abs();
-        let mut out = Vec::new();
+        let (mut out, mut coords) = (Vec::new(), Vec::new());
         for (c, &(centre, half)) in self.cell_box.iter().enumerate() {
             if self.cell_live[c] == 0 {
                 continue;
@@ -492,10 +494,11 @@ impl<'a> PlanePool<'a> {
                 let v = nx * p.x + ny * p.y + nz * p.z + d;
                 if v.abs() < t {
                     out.push(self.voxels.items[lo + k]);
+                    coords.push(*p);
                 }
             }
         }
-        out
+        (out, coords)
     }
 
     /// Pool positions of the inliers of `plane` among the first `k` pool
