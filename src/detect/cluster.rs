@@ -46,6 +46,13 @@ const DENSE_CELLS: u128 = 1 << 21;
 /// round cost more in page faults than the clustering itself.
 #[derive(Default)]
 pub struct Clusterer {
+    /// Dense path: cell id at `y * w + x` (`u32::MAX` when empty), kept
+    /// all-empty between calls.
+    grid: Vec<u32>,
+    w: usize,
+    h: usize,
+    /// Cell coordinates of each cell id (grid or hashed).
+    keys: Vec<(i64, i64)>,
     cell_xy: Vec<(i64, i64)>,
     ids: CellIds,
     cell_of: Vec<u32>,
@@ -69,44 +76,89 @@ impl Clusterer {
         };
         let side = tol / std::f64::consts::SQRT_2;
         let inv = 1.0 / side;
-        // Cell coordinates, once per point, then ids in first-seen order.
-        self.cell_xy.clear();
-        self.cell_xy.extend(
-            points
-                .iter()
-                .map(|p| (floor_i64(p.x * inv), floor_i64(p.y * inv))),
-        );
-        self.ids
-            .assign(&self.cell_xy, DENSE_CELLS, &mut self.cell_of);
-        let cells = self.ids.keys.len();
-        // Points per cell, and each cell's bounding box.
-        self.buckets.fill(&self.cell_of, cells);
-        self.bbox.clear();
-        self.bbox.resize(
-            cells,
-            [
-                f64::INFINITY,
-                f64::INFINITY,
-                f64::NEG_INFINITY,
-                f64::NEG_INFINITY,
-            ],
-        );
-        for (p, &c) in points.iter().zip(&self.cell_of) {
-            let b = &mut self.bbox[c as usize];
-            // Comparisons, not f64::min/max (library calls in wasm).
-            if p.x < b[0] {
-                b[0] = p.x;
+        // The points' box decides between a dense grid over it and hashing.
+        let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+        for p in points {
+            if p.x < lo.x {
+                lo.x = p.x;
             }
-            if p.y < b[1] {
-                b[1] = p.y;
+            if p.y < lo.y {
+                lo.y = p.y;
             }
-            if p.x > b[2] {
-                b[2] = p.x;
+            if p.x > hi.x {
+                hi.x = p.x;
             }
-            if p.y > b[3] {
-                b[3] = p.y;
+            if p.y > hi.y {
+                hi.y = p.y;
             }
         }
+        let (gw, gh) = (
+            ((hi.x - lo.x) * inv).floor() + 1.0,
+            ((hi.y - lo.y) * inv).floor() + 1.0,
+        );
+        let dense = gw * gh <= (4 * n) as f64 + DENSE_CELLS as f64;
+        // Cell ids in first-seen order, each point's cell, and each cell's
+        // bounding box, in one pass (dense) or through `CellIds` (hashed).
+        self.bbox.clear();
+        self.cell_of.clear();
+        self.keys.clear();
+        let empty = [
+            f64::INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        if dense {
+            // Grid cells are squares of `side` from the box's corner; the
+            // clusters do not depend on where the grid starts.
+            let (w, h) = (gw as usize, gh as usize);
+            if self.grid.len() < w * h {
+                self.grid.resize(w * h, u32::MAX);
+            }
+            (self.w, self.h) = (w, h);
+            for p in points {
+                // In range by construction; the clamps only guard rounding.
+                let cx = (((p.x - lo.x) * inv) as usize).min(w - 1);
+                let cy = (((p.y - lo.y) * inv) as usize).min(h - 1);
+                let k = cy * w + cx;
+                let mut id = self.grid[k];
+                if id == u32::MAX {
+                    id = self.keys.len() as u32;
+                    self.grid[k] = id;
+                    self.keys.push((cx as i64, cy as i64));
+                    self.bbox.push(empty);
+                }
+                self.cell_of.push(id);
+                grow(&mut self.bbox[id as usize], *p);
+            }
+        } else {
+            self.cell_xy.clear();
+            self.cell_xy.extend(
+                points
+                    .iter()
+                    .map(|p| (floor_i64(p.x * inv), floor_i64(p.y * inv))),
+            );
+            self.ids.assign(&self.cell_xy, 0, &mut self.cell_of);
+            self.keys.extend_from_slice(&self.ids.keys);
+            self.bbox.resize(self.keys.len(), empty);
+            for (p, &c) in points.iter().zip(&self.cell_of) {
+                grow(&mut self.bbox[c as usize], *p);
+            }
+        }
+        let cells = self.keys.len();
+        self.buckets.fill(&self.cell_of, cells);
+        let (grid, ids, w, h) = (&self.grid, &self.ids, self.w as i64, self.h as i64);
+        let lookup = |x: i64, y: i64| -> Option<u32> {
+            if dense {
+                if x < 0 || y < 0 || x >= w || y >= h {
+                    return None;
+                }
+                let id = grid[(y * w + x) as usize];
+                (id != u32::MAX).then_some(id)
+            } else {
+                ids.get(x, y)
+            }
+        };
         // Half neighbourhood (each unordered pair once) whose boxes are < tol apart.
         let mut offsets = Vec::new();
         for dx in -2i64..=2 {
@@ -136,10 +188,10 @@ impl Clusterer {
         let tol2 = tol * tol;
         let (parent, near) = (&mut self.parent, &mut self.near);
         for c in 0..cells {
-            let (cx, cy) = self.ids.keys[c];
+            let (cx, cy) = self.keys[c];
             let a = self.buckets.of(c);
             for &(dx, dy) in &offsets {
-                let Some(nb) = self.ids.get(cx.wrapping_add(dx), cy.wrapping_add(dy)) else {
+                let Some(nb) = lookup(cx.wrapping_add(dx), cy.wrapping_add(dy)) else {
                     continue;
                 };
                 let (ra, rb) = (find(parent, c as u32), find(parent, nb));
@@ -185,6 +237,12 @@ impl Clusterer {
                 }
             }
         }
+        // Leave the dense grid all-empty for the next call.
+        if dense {
+            for &(x, y) in &self.keys {
+                self.grid[y as usize * self.w + x as usize] = u32::MAX;
+            }
+        }
         // Roots once per cell, then per point a lookup.
         let root: Vec<u32> = (0..cells as u32).map(|c| find(parent, c)).collect();
         let mut size = vec![0u32; cells];
@@ -195,6 +253,24 @@ impl Clusterer {
             root_of_point.push(r);
         }
         (root_of_point, size)
+    }
+}
+
+/// Grow the box `[min x, min y, max x, max y]` to hold `p`, by comparisons
+/// (`f64::min`/`max` are library calls in wasm).
+#[inline]
+fn grow(b: &mut [f64; 4], p: DVec2) {
+    if p.x < b[0] {
+        b[0] = p.x;
+    }
+    if p.y < b[1] {
+        b[1] = p.y;
+    }
+    if p.x > b[2] {
+        b[2] = p.x;
+    }
+    if p.y > b[3] {
+        b[3] = p.y;
     }
 }
 
@@ -239,6 +315,43 @@ mod tests {
         assert_eq!(c.len(), 150);
     }
 
+    /// Sizes of the connected components of the "closer than `tol`" graph.
+    fn brute_force_sizes(pts: &[DVec2], tol: f64) -> Vec<usize> {
+        let n = pts.len();
+        let mut seen = vec![false; n];
+        let mut sizes = Vec::new();
+        for s in 0..n {
+            if seen[s] {
+                continue;
+            }
+            seen[s] = true;
+            let mut stack = vec![s];
+            let mut sz = 0;
+            while let Some(i) = stack.pop() {
+                sz += 1;
+                for j in 0..n {
+                    if !seen[j] && (pts[i] - pts[j]).length() < tol {
+                        seen[j] = true;
+                        stack.push(j);
+                    }
+                }
+            }
+            sizes.push(sz);
+        }
+        sizes.sort_unstable();
+        sizes
+    }
+
+    fn sizes_of(pts: &[DVec2], tol: f64) -> Vec<usize> {
+        let (comp, sizes) = clusters(pts, tol);
+        let mut roots: Vec<u32> = comp.clone();
+        roots.sort_unstable();
+        roots.dedup();
+        let mut out: Vec<usize> = roots.iter().map(|&r| sizes[r as usize] as usize).collect();
+        out.sort_unstable();
+        out
+    }
+
     #[test]
     fn matches_brute_force_on_random_points() {
         let mut r = crate::rng::Rng::new(11);
@@ -246,31 +359,38 @@ mod tests {
             .map(|_| DVec2::new(r.range(0.0, 20.0), r.range(0.0, 20.0)))
             .collect();
         let tol = 0.7;
-        // Brute-force components.
-        let n = pts.len();
-        let mut comp = vec![usize::MAX; n];
-        let mut sizes = Vec::new();
-        for s in 0..n {
-            if comp[s] != usize::MAX {
-                continue;
+        assert_eq!(sizes_of(&pts, tol), brute_force_sizes(&pts, tol));
+        assert_eq!(
+            largest_cluster(&pts, tol).len(),
+            *brute_force_sizes(&pts, tol).last().unwrap()
+        );
+    }
+
+    #[test]
+    fn hashed_grid_matches_brute_force_too() {
+        // Clumps scattered over 2 km x 2 km: far more cells than the dense
+        // grid takes, so the hashed path runs.
+        let mut r = crate::rng::Rng::new(12);
+        let mut pts = Vec::new();
+        for _ in 0..12 {
+            let c = DVec2::new(r.range(0.0, 2000.0), r.range(0.0, 2000.0));
+            let k = 10 + r.below(60);
+            for _ in 0..k {
+                pts.push(c + DVec2::new(r.range(0.0, 3.0), r.range(0.0, 1.0)));
             }
-            let id = sizes.len();
-            let mut stack = vec![s];
-            comp[s] = id;
-            let mut sz = 0;
-            while let Some(i) = stack.pop() {
-                sz += 1;
-                for j in 0..n {
-                    if comp[j] == usize::MAX && (pts[i] - pts[j]).length() < tol {
-                        comp[j] = id;
-                        stack.push(j);
-                    }
-                }
-            }
-            sizes.push(sz);
         }
-        let best = *sizes.iter().max().unwrap();
-        assert_eq!(largest_cluster(&pts, tol).len(), best);
+        let tol = 0.5;
+        let mut c = Clusterer::default();
+        assert_eq!(c.clusters(&pts, tol).0.len(), pts.len());
+        assert!(c.grid.is_empty(), "the dense grid was used");
+        assert_eq!(sizes_of(&pts, tol), brute_force_sizes(&pts, tol));
+        // The same instance, reused on a dense input, gives the same as a
+        // fresh one.
+        let dense: Vec<DVec2> = (0..400)
+            .map(|_| DVec2::new(r.range(0.0, 15.0), r.range(0.0, 15.0)))
+            .collect();
+        assert_eq!(c.clusters(&dense, 0.6), clusters(&dense, 0.6));
+        assert!(c.grid.iter().all(|&g| g == u32::MAX));
     }
 
     #[test]
