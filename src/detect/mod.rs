@@ -198,8 +198,8 @@ impl<'p> Detector<'p> {
                         .zip(&s.kept)
                         .filter_map(|(&i, &k)| k.then_some(i))
                         .collect();
-                    for &i in &taken {
-                        labels[i as usize] = id;
+                    for &v in &taken {
+                        labels[pool.original(v) as usize] = id;
                     }
                     pool.remove(&taken);
                     let mut prim = s.primitive;

@@ -58,20 +58,28 @@ pub struct LocalPlane {
 }
 
 /// The points not yet explained, and the sampling structures over them.
-pub struct PlanePool<'a> {
-    pts: &'a [Vec3],
+///
+/// Points are known by their *position*: their rank in voxel order
+/// (`voxels.items[v]` is the original index of position `v`). Per-point
+/// state lives in position order, so what one round touches (the inliers of
+/// one plane, collected voxel by voxel) is close together in memory; only
+/// labels go back to original indices.
+pub struct PlanePool {
+    /// Per position: still in play?
     alive: Vec<bool>,
     rx: Vec<f32>,
     ry: Vec<f32>,
     rz: Vec<f32>,
+    /// Scoring pool: positions in random order.
     ridx: Vec<u32>,
+    /// Per position: its voxel.
     cell_of: Vec<u32>,
     /// Original indices grouped by voxel.
     voxels: Buckets,
-    /// Coordinates in `voxels.items` order (NaN once dead): the full inlier
-    /// collection reads only the voxels a plane's slab crosses.
+    /// Coordinates by position (NaN once dead): the full inlier collection
+    /// reads only the voxels a plane's slab crosses.
     cell_pts: Vec<Vec3>,
-    /// Position of each original index in `voxels.items`.
+    /// Position of each original index.
     cell_pos_of: Vec<u32>,
     /// Bounding box of each voxel's points (centre, half extent), f64.
     cell_box: Vec<(DVec3, DVec3)>,
@@ -83,7 +91,7 @@ pub struct PlanePool<'a> {
     /// Of those, how many are in the scoring pool (whose arrays may also
     /// hold dead ones, as NaN).
     pool_live: usize,
-    /// Pool position of each original index (`u32::MAX` when not in the pool).
+    /// Pool position of each position (`u32::MAX` when not in the pool).
     pos_of: Vec<u32>,
     /// Point-to-plane distance evaluations so far.
     pub work: u64,
@@ -101,9 +109,9 @@ const POOL_CAP: usize = 1 << 18;
 /// Most points the local optimisation (robust refit) looks at.
 const LO_SAMPLE: usize = 16_384;
 
-impl<'a> PlanePool<'a> {
+impl PlanePool {
     /// All of `pts` in play, shuffled once with `rng`.
-    pub fn new(pts: &'a [Vec3], sample_radius: f64, mut rng: Rng) -> Self {
+    pub fn new(pts: &[Vec3], sample_radius: f64, mut rng: Rng) -> Self {
         let n = pts.len();
         // The scoring pool: every point in random order, or beyond POOL_CAP
         // points a uniform random subset of POOL_CAP; every prefix is a
@@ -120,12 +128,15 @@ impl<'a> PlanePool<'a> {
         // Sampling voxels (ids in first-seen order of the original indices).
         let voxels = crate::hash::voxelise(pts, sample_radius.max(1e-3));
         let cells = voxels.coords.len();
-        let cell_of = voxels.cell_of;
-        let buckets = Buckets::new(&cell_of, cells);
+        let buckets = Buckets::new(&voxels.cell_of, cells);
         let cell_pts: Vec<Vec3> = buckets.items.iter().map(|&i| pts[i as usize]).collect();
         let mut cell_pos_of = vec![0u32; n];
         for (pos, &i) in buckets.items.iter().enumerate() {
             cell_pos_of[i as usize] = pos as u32;
+        }
+        let mut cell_of = Vec::with_capacity(n);
+        for c in 0..cells {
+            cell_of.resize(buckets.range(c).end, c as u32);
         }
         // Boxes from the points themselves, not from the voxel keys (keys
         // wrap for coordinates beyond 2^21 voxels, boxes never lie).
@@ -148,7 +159,6 @@ impl<'a> PlanePool<'a> {
             cell_live,
             live: n,
             pos_of: vec![u32::MAX; n],
-            pts,
             alive: vec![true; n],
             rx: Vec::new(),
             ry: Vec::new(),
@@ -159,8 +169,16 @@ impl<'a> PlanePool<'a> {
             rng,
             work: 0,
         };
+        for i in order.iter_mut() {
+            *i = pool.cell_pos_of[*i as usize];
+        }
         pool.set_pool(order);
         pool
+    }
+
+    /// Original index of position `v`.
+    pub fn original(&self, v: u32) -> u32 {
+        self.voxels.items[v as usize]
     }
 
     /// Number of points still in play.
@@ -174,20 +192,24 @@ impl<'a> PlanePool<'a> {
         for &i in &self.ridx {
             self.pos_of[i as usize] = u32::MAX;
         }
-        let mut order: Vec<u32> = (0..self.pts.len() as u32)
-            .filter(|&i| self.alive[i as usize])
+        // Live points in original order (as always: the same random subset).
+        let mut order: Vec<u32> = self
+            .cell_pos_of
+            .iter()
+            .copied()
+            .filter(|&v| self.alive[v as usize])
             .collect();
         random_prefix(&mut order, POOL_CAP, &mut self.rng);
         self.set_pool(order);
     }
 
-    /// Make these (live, original) indices the scoring pool, in this order.
+    /// Make these (live) positions the scoring pool, in this order.
     fn set_pool(&mut self, order: Vec<u32>) {
         self.rx.clear();
         self.ry.clear();
         self.rz.clear();
         for (pos, &i) in order.iter().enumerate() {
-            let p = self.pts[i as usize];
+            let p = self.cell_pts[i as usize];
             self.rx.push(p.x);
             self.ry.push(p.y);
             self.rz.push(p.z);
@@ -197,7 +219,7 @@ impl<'a> PlanePool<'a> {
         self.ridx = order;
     }
 
-    /// Take these original indices out of play. Their coordinates in the
+    /// Take these positions out of play. Their coordinates in the
     /// pool become NaN, which fails every inlier test, so no pass over the
     /// pool needs to check liveness; the arrays are compacted only once half
     /// of them is dead (which keeps the order, so prefixes stay random).
@@ -208,7 +230,7 @@ impl<'a> PlanePool<'a> {
             }
             self.alive[i as usize] = false;
             self.live -= 1;
-            self.cell_pts[self.cell_pos_of[i as usize] as usize] = Vec3::NAN;
+            self.cell_pts[i as usize] = Vec3::NAN;
             self.cell_live[self.cell_of[i as usize] as usize] -= 1;
             let pos = self.pos_of[i as usize];
             if pos != u32::MAX {
@@ -241,8 +263,8 @@ impl<'a> PlanePool<'a> {
     }
 
     /// The plane with the largest consensus among the remaining points, its
-    /// inliers (original indices) and their coordinates, or `None` when no
-    /// plane has `min_inliers`.
+    /// inliers (positions, in voxel order) and their coordinates, or `None`
+    /// when no plane has `min_inliers`.
     /// `viewpoint` is the sensor in local coordinates: horizontal planes at
     /// least `ground_depth` below it are counted with the ground distance.
     pub fn best_plane(
@@ -343,21 +365,22 @@ impl<'a> PlanePool<'a> {
     /// Judged on at most 64 of its members (an even stride): near the sensor
     /// a voxel holds thousands of points, and an estimate is all this needs.
     fn locally_planar(&mut self, plane: &LocalPlane, cell: usize) -> bool {
-        let members = self.voxels.of(cell);
-        let step = members.len().div_ceil(64).max(1);
+        let members = self.voxels.range(cell);
+        let len = members.len();
+        let step = len.div_ceil(64).max(1);
         let (n, d, t) = (
             plane.normal.as_vec3(),
             plane.offset as f32,
             plane.threshold as f32,
         );
         let (mut live, mut on) = (0u32, 0u32);
-        for &j in members.iter().step_by(step) {
-            if self.alive[j as usize] {
+        for j in members.step_by(step) {
+            if self.alive[j] {
                 live += 1;
-                on += ((n.dot(self.pts[j as usize]) + d).abs() < t) as u32;
+                on += ((n.dot(self.cell_pts[j]) + d).abs() < t) as u32;
             }
         }
-        self.work += (members.len() / step) as u64;
+        self.work += (len / step) as u64;
         10 * on >= 3 * live
     }
 
@@ -379,10 +402,10 @@ impl<'a> PlanePool<'a> {
             return None;
         }
         let c = self.cell_of[i1 as usize] as usize;
-        let members = self.voxels.of(c);
+        let members = self.voxels.range(c);
         let pick = |rng: &mut Rng, not: &[u32]| -> u32 {
             for _ in 0..6 {
-                let j = members[rng.below(members.len())];
+                let j = (members.start + rng.below(members.len())) as u32;
                 if self.alive[j as usize] && !not.contains(&j) {
                     return j;
                 }
@@ -397,9 +420,9 @@ impl<'a> PlanePool<'a> {
         let i2 = pick(&mut self.rng, &[i1]);
         let i3 = pick(&mut self.rng, &[i1, i2]);
         let (p1, p2, p3) = (
-            self.pts[i1 as usize].as_dvec3(),
-            self.pts[i2 as usize].as_dvec3(),
-            self.pts[i3 as usize].as_dvec3(),
+            self.cell_pts[i1 as usize].as_dvec3(),
+            self.cell_pts[i2 as usize].as_dvec3(),
+            self.cell_pts[i3 as usize].as_dvec3(),
         );
         let cr = (p2 - p1).cross(p3 - p1);
         // std sqrt (a single instruction in wasm; glam with libm calls software):
@@ -461,7 +484,7 @@ impl<'a> PlanePool<'a> {
         self.inliers_in(plane, k)
     }
 
-    /// All inliers of `plane` (original indices, in voxel order) and their
+    /// All inliers of `plane` (positions, in voxel order) and their
     /// coordinates (read here in voxel order anyway; gathering them again
     /// by index afterwards costs a cache miss a point). Only the
     /// voxels whose point box reaches within the threshold of the plane are
@@ -493,7 +516,7 @@ impl<'a> PlanePool<'a> {
             for (k, p) in self.cell_pts[range].iter().enumerate() {
                 let v = nx * p.x + ny * p.y + nz * p.z + d;
                 if v.abs() < t {
-                    out.push(self.voxels.items[lo + k]);
+                    out.push((lo + k) as u32);
                     coords.push(*p);
                 }
             }
