@@ -195,6 +195,9 @@ fn coplanar_walls_with_a_gap_stay_two_polygons() {
     for hull in [HullKind::Convex, HullKind::Concave] {
         let p = Params {
             hull,
+            // In front of the gap (at the default, the origin, the sensor
+            // would stand in the walls' plane and could see neither).
+            viewpoint: [7.5, -6.0, 1.5],
             ..Params::gpp2()
         };
         let det = detect(&cloud, &p).unwrap();
@@ -581,4 +584,75 @@ fn simulated_street_scans_and_a_location_meet_quality_floors() {
         "location mean {:?}",
         m.accuracy.mean
     );
+}
+
+/// A sensor cannot see a surface it lies in: a plane through the viewpoint,
+/// away from it, is the laser rings at the sensor's own height (over a
+/// location they close into a few m^2 of false surface). Such a candidate
+/// is dropped; the same patch a little higher, and a floor under a sensor
+/// standing on it, are kept.
+#[test]
+fn planes_through_the_viewpoint_away_from_it_are_not_surfaces() {
+    let mut rng = Rng::new(21);
+    let ground = |rng: &mut Rng, pts: &mut Vec<DVec3>| {
+        rect(
+            pts,
+            DVec3::new(-15.0, -15.0, 0.0),
+            DVec3::X,
+            DVec3::Y,
+            30.0,
+            30.0,
+            0.1,
+            0.005,
+            rng,
+        );
+    };
+    let patch_at = |z: f64, rng: &mut Rng| {
+        let mut pts = Vec::new();
+        ground(rng, &mut pts);
+        rect(
+            &mut pts,
+            DVec3::new(6.0, -1.5, z),
+            DVec3::X,
+            DVec3::Y,
+            3.0,
+            3.0,
+            0.05,
+            0.0,
+            rng,
+        );
+        pts
+    };
+    let flat_at = |det: &polyscene::detect::Detection, z: f64| {
+        det.primitives
+            .iter()
+            .filter(|q| {
+                q.plane.normal.z.abs() > 0.999
+                    && (q.plane.offset * q.plane.normal.z + z).abs() < 0.02
+            })
+            .count()
+    };
+    let p = Params {
+        viewpoint: [0.0, 0.0, 1.8],
+        ..Params::gpp2()
+    };
+    // At sensor height: only the ground.
+    let c = cloud(&patch_at(1.8, &mut rng));
+    let det = detect(&c, &p).unwrap();
+    check_invariants(&c, &det, &p);
+    assert_eq!(flat_at(&det, 0.0), 1);
+    assert_eq!(flat_at(&det, 1.8), 0);
+    // Half a metre higher it is seen from below: kept.
+    let c = cloud(&patch_at(2.3, &mut rng));
+    let det = detect(&c, &p).unwrap();
+    assert_eq!((flat_at(&det, 0.0), flat_at(&det, 2.3)), (1, 1));
+    // A sensor standing on the floor sees the floor.
+    let mut pts = Vec::new();
+    ground(&mut rng, &mut pts);
+    let c = cloud(&pts);
+    let on_floor = Params {
+        viewpoint: [2.0, 3.0, 0.0],
+        ..Params::gpp2()
+    };
+    assert_eq!(flat_at(&detect(&c, &on_floor).unwrap(), 0.0), 1);
 }

@@ -8,9 +8,10 @@ pub mod ransac;
 use crate::clock;
 use crate::cloud::Cloud;
 use crate::error::Result;
+use crate::geometry::polygon::{contains, distance};
 use crate::geometry::{Frame, Plane};
 use crate::params::Params;
-use crate::primitive::{shape, Primitive};
+use crate::primitive::{shape, Primitive, Shaped};
 use crate::rng::Rng;
 use glam::{DVec2, DVec3, Vec3};
 use ransac::PlanePool;
@@ -78,6 +79,23 @@ pub fn detect(cloud: &Cloud, params: &Params) -> Result<Detection> {
     params.validate()?;
     let viewpoint = DVec3::from_array(params.viewpoint);
     Ok(Detector::new(params).run(&cloud.points, cloud.origin, viewpoint))
+}
+
+/// Is this candidate a plane the sensor lies in, away from it? Its plane
+/// passes within two inlier distances of the viewpoint, so every ray to it
+/// grazes, and the viewpoint's foot point is more than a metre outside its
+/// outline (a floor under a sensor standing on it is kept). Such a
+/// candidate is the laser rings of the beams near its own elevation,
+/// gathered across everything around (horizontal at sensor height, most
+/// often); the outline closes them into solid-looking patches, and the
+/// arcs they draw on poles and trunks pass the normal-consistency test.
+fn seen_edge_on(s: &Shaped, viewpoint: DVec3, p: &Params) -> bool {
+    let prim = &s.primitive;
+    if prim.plane.signed_distance(viewpoint).abs() >= 2.0 * p.distance {
+        return false;
+    }
+    let foot = prim.frame.to_local(viewpoint);
+    !contains(&prim.outline, foot) && distance(&prim.outline, foot) > 1.0
 }
 
 /// The detection cascade with its parameters (validated by the caller).
@@ -190,7 +208,8 @@ impl<'p> Detector<'p> {
                 Some(s)
                     if s.primitive.acceptable(p)
                         && s.roughness <= p.max_roughness
-                        && s.consistency >= p.min_normal_consistency =>
+                        && s.consistency >= p.min_normal_consistency
+                        && !seen_edge_on(&s, viewpoint, p) =>
                 {
                     let id = primitives.len() as u32;
                     let taken: Vec<u32> = cluster
