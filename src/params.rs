@@ -59,9 +59,10 @@ pub struct Params {
     /// primitive. Default 1.3 (sensors on a car roof sit 1.7-2 m up).
     pub ground_depth: f64,
     /// Sensor position for one-shot detection (world, m): normals of
-    /// non-horizontal planes point towards it, and it decides what is
-    /// ground. Default `[0, 0, 0]`: a scan in its own sensor frame. The
-    /// scenario uses each scan's pose instead.
+    /// non-horizontal planes point towards it, it decides what is ground,
+    /// and a plane through it (seen edge-on: laser rings) is dropped unless
+    /// it reaches within 1 m of it. Default `[0, 0, 0]`: a scan in its own
+    /// sensor frame. The scenario uses each scan's pose instead.
     pub viewpoint: [f64; 3],
     /// Fewest inliers a plane needs, and fewest support points a primitive
     /// needs; the cascade stops when the best plane has fewer. gpp2 default
