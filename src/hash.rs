@@ -164,13 +164,7 @@ impl CellIds {
     /// cell id into `cell_of` (cleared first). `extra` sets how large an
     /// empty box still gets the dense array.
     pub fn assign(&mut self, xy: &[(i64, i64)], extra: u128, cell_of: &mut Vec<u32>) {
-        // Leave the dense array all-empty from the previous call.
-        if self.dense {
-            for &(x, y) in &self.keys {
-                self.ids[(y - self.lo.1) as usize * self.w + (x - self.lo.0) as usize] = u32::MAX;
-            }
-        }
-        self.keys.clear();
+        self.reset();
         cell_of.clear();
         let (mut lo, mut hi) = ((i64::MAX, i64::MAX), (i64::MIN, i64::MIN));
         for &(x, y) in xy {
@@ -189,23 +183,107 @@ impl CellIds {
             }
             for &(x, y) in xy {
                 let k = (y - lo.1) as usize * self.w + (x - lo.0) as usize;
-                if self.ids[k] == u32::MAX {
-                    self.ids[k] = self.keys.len() as u32;
-                    self.keys.push((x, y));
-                }
-                cell_of.push(self.ids[k]);
+                cell_of.push(self.number_dense(k, (x, y)));
             }
         } else {
             self.map.clear();
             for &(x, y) in xy {
-                let next = self.keys.len() as u32;
-                let id = *self.map.entry(key2(x, y)).or_insert(next);
-                if id == next {
-                    self.keys.push((x, y));
-                }
-                cell_of.push(id);
+                cell_of.push(self.number_hashed((x, y)));
             }
         }
+    }
+
+    /// [`CellIds::assign`] for the square cells of side `1 / inv` holding
+    /// `points` (finite), numbered straight from the points in one pass, with
+    /// `seen(id, p)` called for every point in order (a caller's per-cell
+    /// statistics ride along). Dense when the points' box spans at most
+    /// `4 * points + extra` cells: the grid then starts at the box's corner
+    /// (keys count from 0); else cells are `floor(coordinate * inv)`. So the
+    /// cell boundaries depend on the points: for callers that only need
+    /// "same cell" and neighbour relations (clustering), not for fixed
+    /// patches.
+    pub fn assign_points(
+        &mut self,
+        points: &[glam::DVec2],
+        inv: f64,
+        extra: u128,
+        cell_of: &mut Vec<u32>,
+        mut seen: impl FnMut(u32, glam::DVec2),
+    ) {
+        self.reset();
+        cell_of.clear();
+        let (mut lo, mut hi) = (
+            glam::DVec2::splat(f64::INFINITY),
+            glam::DVec2::splat(f64::NEG_INFINITY),
+        );
+        for &p in points {
+            crate::geometry::grow_box(&mut lo, &mut hi, p);
+        }
+        let (gw, gh) = (
+            ((hi.x - lo.x) * inv).floor() + 1.0,
+            ((hi.y - lo.y) * inv).floor() + 1.0,
+        );
+        self.dense = !points.is_empty() && gw * gh <= (4 * points.len()) as f64 + extra as f64;
+        if self.dense {
+            let (w, h) = (gw as usize, gh as usize);
+            (self.lo, self.w, self.h) = ((0, 0), w, h);
+            if self.ids.len() < w * h {
+                self.ids.resize(w * h, u32::MAX);
+            }
+            for &p in points {
+                // In range by construction; the clamps only guard rounding.
+                let x = (((p.x - lo.x) * inv) as usize).min(w - 1);
+                let y = (((p.y - lo.y) * inv) as usize).min(h - 1);
+                let id = self.number_dense(y * w + x, (x as i64, y as i64));
+                cell_of.push(id);
+                seen(id, p);
+            }
+        } else {
+            self.map.clear();
+            for &p in points {
+                let id = self.number_hashed((floor_i64(p.x * inv), floor_i64(p.y * inv)));
+                cell_of.push(id);
+                seen(id, p);
+            }
+        }
+    }
+
+    /// Did the last assignment use the dense array?
+    pub fn is_dense(&self) -> bool {
+        self.dense
+    }
+
+    /// Leave the dense array all-empty from the previous call and forget
+    /// the keys.
+    fn reset(&mut self) {
+        if self.dense {
+            for &(x, y) in &self.keys {
+                self.ids[(y - self.lo.1) as usize * self.w + (x - self.lo.0) as usize] = u32::MAX;
+            }
+        }
+        self.keys.clear();
+    }
+
+    /// Id of the cell at dense index `k` with coordinates `xy`, numbered
+    /// when new.
+    #[inline]
+    fn number_dense(&mut self, k: usize, xy: (i64, i64)) -> u32 {
+        if self.ids[k] == u32::MAX {
+            self.ids[k] = self.keys.len() as u32;
+            self.keys.push(xy);
+        }
+        self.ids[k]
+    }
+
+    /// Id of the cell `xy` through the map, numbered when new.
+    #[inline]
+    fn number_hashed(&mut self, xy: (i64, i64)) -> u32 {
+        let next = self.keys.len() as u32;
+        let id = *self.map.entry(key2(xy.0, xy.1)).or_insert(next);
+        if id == next {
+            self.keys.push(xy);
+        }
+        id
     }
 
     /// Id of the cell `(x, y)` of the last [`CellIds::assign`], if it had

@@ -7,7 +7,8 @@
 //! than `tol`; only cells whose boxes are closer than `tol` are compared (a
 //! 5x5 neighbourhood), and the comparison stops at the first close pair.
 
-use crate::hash::{floor_i64, Buckets, CellIds};
+use crate::geometry::grow_box;
+use crate::hash::{Buckets, CellIds};
 use glam::DVec2;
 
 /// Indices of the points in the largest cluster (ties: the cluster holding
@@ -46,18 +47,11 @@ const DENSE_CELLS: u128 = 1 << 21;
 /// round cost more in page faults than the clustering itself.
 #[derive(Default)]
 pub struct Clusterer {
-    /// Dense path: cell id at `y * w + x` (`u32::MAX` when empty), kept
-    /// all-empty between calls.
-    grid: Vec<u32>,
-    w: usize,
-    h: usize,
-    /// Cell coordinates of each cell id (grid or hashed).
-    keys: Vec<(i64, i64)>,
-    cell_xy: Vec<(i64, i64)>,
     ids: CellIds,
     cell_of: Vec<u32>,
     buckets: Buckets,
-    bbox: Vec<[f64; 4]>,
+    /// Bounding box (min, max) of each cell's points.
+    bbox: Vec<(DVec2, DVec2)>,
     near: Vec<DVec2>,
     parent: Vec<u32>,
 }
@@ -76,89 +70,19 @@ impl Clusterer {
         };
         let side = tol / std::f64::consts::SQRT_2;
         let inv = 1.0 / side;
-        // The points' box decides between a dense grid over it and hashing.
-        let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
-        for p in points {
-            if p.x < lo.x {
-                lo.x = p.x;
-            }
-            if p.y < lo.y {
-                lo.y = p.y;
-            }
-            if p.x > hi.x {
-                hi.x = p.x;
-            }
-            if p.y > hi.y {
-                hi.y = p.y;
-            }
-        }
-        let (gw, gh) = (
-            ((hi.x - lo.x) * inv).floor() + 1.0,
-            ((hi.y - lo.y) * inv).floor() + 1.0,
-        );
-        let dense = gw * gh <= (4 * n) as f64 + DENSE_CELLS as f64;
-        // Cell ids in first-seen order, each point's cell, and each cell's
-        // bounding box, in one pass (dense) or through `CellIds` (hashed).
-        self.bbox.clear();
-        self.cell_of.clear();
-        self.keys.clear();
-        let empty = [
-            f64::INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::NEG_INFINITY,
-        ];
-        if dense {
-            // Grid cells are squares of `side` from the box's corner; the
-            // clusters do not depend on where the grid starts.
-            let (w, h) = (gw as usize, gh as usize);
-            if self.grid.len() < w * h {
-                self.grid.resize(w * h, u32::MAX);
-            }
-            (self.w, self.h) = (w, h);
-            for p in points {
-                // In range by construction; the clamps only guard rounding.
-                let cx = (((p.x - lo.x) * inv) as usize).min(w - 1);
-                let cy = (((p.y - lo.y) * inv) as usize).min(h - 1);
-                let k = cy * w + cx;
-                let mut id = self.grid[k];
-                if id == u32::MAX {
-                    id = self.keys.len() as u32;
-                    self.grid[k] = id;
-                    self.keys.push((cx as i64, cy as i64));
-                    self.bbox.push(empty);
+        // Cell ids in first-seen order, each point's cell and each cell's
+        // bounding box, in one pass over the points.
+        let (bbox, cell_of) = (&mut self.bbox, &mut self.cell_of);
+        bbox.clear();
+        self.ids
+            .assign_points(points, inv, DENSE_CELLS, cell_of, |id, p| {
+                match bbox.get_mut(id as usize) {
+                    Some((lo, hi)) => grow_box(lo, hi, p),
+                    None => bbox.push((p, p)),
                 }
-                self.cell_of.push(id);
-                grow(&mut self.bbox[id as usize], *p);
-            }
-        } else {
-            self.cell_xy.clear();
-            self.cell_xy.extend(
-                points
-                    .iter()
-                    .map(|p| (floor_i64(p.x * inv), floor_i64(p.y * inv))),
-            );
-            self.ids.assign(&self.cell_xy, 0, &mut self.cell_of);
-            self.keys.extend_from_slice(&self.ids.keys);
-            self.bbox.resize(self.keys.len(), empty);
-            for (p, &c) in points.iter().zip(&self.cell_of) {
-                grow(&mut self.bbox[c as usize], *p);
-            }
-        }
-        let cells = self.keys.len();
+            });
+        let cells = self.ids.keys.len();
         self.buckets.fill(&self.cell_of, cells);
-        let (grid, ids, w, h) = (&self.grid, &self.ids, self.w as i64, self.h as i64);
-        let lookup = |x: i64, y: i64| -> Option<u32> {
-            if dense {
-                if x < 0 || y < 0 || x >= w || y >= h {
-                    return None;
-                }
-                let id = grid[(y * w + x) as usize];
-                (id != u32::MAX).then_some(id)
-            } else {
-                ids.get(x, y)
-            }
-        };
         // Half neighbourhood (each unordered pair once) whose boxes are < tol apart.
         let mut offsets = Vec::new();
         for dx in -2i64..=2 {
@@ -178,9 +102,9 @@ impl Clusterer {
         // (near the sensor a cell holds hundreds of points, and two diagonal
         // cells without a close pair would otherwise cost the product of
         // their sizes).
-        let box_gap2 = |p: DVec2, b: &[f64; 4]| {
-            let dx = max0(b[0] - p.x, p.x - b[2]);
-            let dy = max0(b[1] - p.y, p.y - b[3]);
+        let box_gap2 = |p: DVec2, b: &(DVec2, DVec2)| {
+            let dx = max0(b.0.x - p.x, p.x - b.1.x);
+            let dy = max0(b.0.y - p.y, p.y - b.1.y);
             dx * dx + dy * dy
         };
         self.parent.clear();
@@ -188,10 +112,10 @@ impl Clusterer {
         let tol2 = tol * tol;
         let (parent, near) = (&mut self.parent, &mut self.near);
         for c in 0..cells {
-            let (cx, cy) = self.keys[c];
+            let (cx, cy) = self.ids.keys[c];
             let a = self.buckets.of(c);
             for &(dx, dy) in &offsets {
-                let Some(nb) = lookup(cx.wrapping_add(dx), cy.wrapping_add(dy)) else {
+                let Some(nb) = self.ids.get(cx.wrapping_add(dx), cy.wrapping_add(dy)) else {
                     continue;
                 };
                 let (ra, rb) = (find(parent, c as u32), find(parent, nb));
@@ -199,8 +123,8 @@ impl Clusterer {
                     continue;
                 }
                 let (ba, bb) = (&self.bbox[c], &self.bbox[nb as usize]);
-                let gx = max0(bb[0] - ba[2], ba[0] - bb[2]);
-                let gy = max0(bb[1] - ba[3], ba[1] - bb[3]);
+                let gx = max0(bb.0.x - ba.1.x, ba.0.x - bb.1.x);
+                let gy = max0(bb.0.y - ba.1.y, ba.0.y - bb.1.y);
                 if gx * gx + gy * gy >= tol2 {
                     continue;
                 }
@@ -237,12 +161,6 @@ impl Clusterer {
                 }
             }
         }
-        // Leave the dense grid all-empty for the next call.
-        if dense {
-            for &(x, y) in &self.keys {
-                self.grid[y as usize * self.w + x as usize] = u32::MAX;
-            }
-        }
         // Roots once per cell, then per point a lookup.
         let root: Vec<u32> = (0..cells as u32).map(|c| find(parent, c)).collect();
         let mut size = vec![0u32; cells];
@@ -253,24 +171,6 @@ impl Clusterer {
             root_of_point.push(r);
         }
         (root_of_point, size)
-    }
-}
-
-/// Grow the box `[min x, min y, max x, max y]` to hold `p`, by comparisons
-/// (`f64::min`/`max` are library calls in wasm).
-#[inline]
-fn grow(b: &mut [f64; 4], p: DVec2) {
-    if p.x < b[0] {
-        b[0] = p.x;
-    }
-    if p.y < b[1] {
-        b[1] = p.y;
-    }
-    if p.x > b[2] {
-        b[2] = p.x;
-    }
-    if p.y > b[3] {
-        b[3] = p.y;
     }
 }
 
@@ -382,7 +282,7 @@ mod tests {
         let tol = 0.5;
         let mut c = Clusterer::default();
         assert_eq!(c.clusters(&pts, tol).0.len(), pts.len());
-        assert!(c.grid.is_empty(), "the dense grid was used");
+        assert!(!c.ids.is_dense(), "the dense grid was used");
         assert_eq!(sizes_of(&pts, tol), brute_force_sizes(&pts, tol));
         // The same instance, reused on a dense input, gives the same as a
         // fresh one.
@@ -390,7 +290,10 @@ mod tests {
             .map(|_| DVec2::new(r.range(0.0, 15.0), r.range(0.0, 15.0)))
             .collect();
         assert_eq!(c.clusters(&dense, 0.6), clusters(&dense, 0.6));
-        assert!(c.grid.iter().all(|&g| g == u32::MAX));
+        assert!(c.ids.is_dense(), "the hashed path was used");
+        // And back: hashed after dense, dense after hashed.
+        assert_eq!(c.clusters(&pts, tol), clusters(&pts, tol));
+        assert_eq!(c.clusters(&dense, 0.6), clusters(&dense, 0.6));
     }
 
     #[test]
