@@ -35,9 +35,12 @@
 //!   its inliers are then collected once from all remaining points.
 //!
 //! Bounds on work per primitive: at most `max_hypotheses * k` distance
-//! evaluations per prefix size (and at most `4 * max_hypotheses` samples), prefix sizes grow geometrically to `n`, plus
-//! one full pass over the `n` remaining points. Every evaluation is
-//! counted in `work` so the cascade can enforce `Params::max_work`.
+//! evaluations per prefix size (and at most `4 * max_hypotheses` samples),
+//! prefix sizes grow geometrically to `n`, plus three passes over at most
+//! 16 384 points for the local optimisation and at most one pass over the
+//! `n` remaining points (with a test per live voxel) to collect the inliers.
+//! Every evaluation is counted in `work` so the cascade can enforce
+//! `Params::max_work`.
 
 use crate::geometry::Moments;
 use crate::hash::Buckets;
