@@ -80,9 +80,21 @@ pub struct Params {
     pub seed: u64,
 
     // --- Clustering ---
-    /// Euclidean clustering tolerance (m): inliers closer than this (measured
-    /// in the plane) are connected. Default 0.5 (authors: 0.9).
+    /// Euclidean clustering tolerance (m): inliers of a non-ground plane
+    /// closer than this (measured in the plane) are connected. Default 0.5
+    /// (authors: 0.9, for every plane; 0.9 joins uniform clutter inside a
+    /// plane's slab into one sheet).
     pub cluster_tolerance: f64,
+    /// Euclidean clustering tolerance for ground planes (m). The ground is
+    /// seen at grazing angles: its laser rings lie farther apart with range
+    /// (a metre apart 20 m out for an HDL-64E), and a tight tolerance cuts a
+    /// road into a polygon per group of rings, or drops the far rings.
+    /// Default 0.5, as for other planes. 1.0 (the ground outline's radius)
+    /// is better for one-shot detection (simulated scans and locations:
+    /// higher recall and completeness, lower error, fewer rounds; see
+    /// BENCHMARKS.md) but costs the incremental scenario some sidewalk and
+    /// curb coverage.
+    pub ground_cluster_tolerance: f64,
 
     // --- Outline ---
     /// Convex or concave outlines. Default concave.
@@ -196,6 +208,7 @@ impl Params {
             sample_radius: 1.0,
             seed: 7,
             cluster_tolerance: 0.5,
+            ground_cluster_tolerance: 0.5,
             hull: HullKind::Concave,
             alpha: 0.5,
             ground_alpha: 1.0,
@@ -387,6 +400,11 @@ impl Params {
         }
         pos("sampleRadius", self.sample_radius, 1000.0)?;
         pos("clusterTolerance", self.cluster_tolerance, 1000.0)?;
+        pos(
+            "groundClusterTolerance",
+            self.ground_cluster_tolerance,
+            1000.0,
+        )?;
         pos("alpha", self.alpha, 1000.0)?;
         pos("groundAlpha", self.ground_alpha, 1000.0)?;
         pos("cell", self.cell, 100.0)?;

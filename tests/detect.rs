@@ -656,3 +656,57 @@ fn planes_through_the_viewpoint_away_from_it_are_not_surfaces() {
     };
     assert_eq!(flat_at(&detect(&c, &on_floor).unwrap(), 0.0), 1);
 }
+
+/// Laser rings on flat ground: 0.15 m apart near the sensor, 0.8 m apart
+/// beyond 12 m (as an HDL-64E's lower rings are 15-20 m out). With the
+/// ground's clustering tolerance above the far spacing all rings are one
+/// surface and one polygon; with the default 0.5 m the far rings are strips
+/// of their own, too thin to be polygons, and only the near disc is mapped.
+#[test]
+fn ground_rings_join_under_the_ground_clustering_tolerance() {
+    let mut rng = Rng::new(11);
+    let mut pts = Vec::new();
+    let radii: Vec<f64> = (0..60)
+        .map(|k| 3.0 + 0.15 * k as f64)
+        .chain((0..8).map(|k| 12.8 + 0.8 * k as f64))
+        .collect();
+    for &r in &radii {
+        let steps = (std::f64::consts::TAU * r / 0.1) as usize;
+        for s in 0..steps {
+            let a = std::f64::consts::TAU * s as f64 / steps as f64;
+            let rr = r + rng.range(-0.03, 0.03);
+            pts.push(DVec3::new(
+                rr * libm::cos(a),
+                rr * libm::sin(a),
+                rng.range(-0.01, 0.01),
+            ));
+        }
+    }
+    let cloud = cloud(&pts);
+    let ground_area = |tol: f64| {
+        let p = Params {
+            viewpoint: [0.0, 0.0, 1.8],
+            ground_cluster_tolerance: tol,
+            ..Params::gpp2()
+        };
+        let det = detect(&cloud, &p).unwrap();
+        check_invariants(&cloud, &det, &p);
+        det.primitives
+            .iter()
+            .filter(|q| q.ground)
+            .map(|q| q.area)
+            .fold(0.0, f64::max)
+    };
+    let annulus = std::f64::consts::PI * (18.4f64.powi(2) - 3.0f64.powi(2));
+    let near = std::f64::consts::PI * (11.85f64.powi(2) - 3.0f64.powi(2));
+    let joined = ground_area(1.0);
+    assert!(
+        joined > 0.9 * annulus && joined < 1.05 * annulus,
+        "one polygon over all rings: {joined} m^2 of {annulus}"
+    );
+    let split = ground_area(Params::gpp2().ground_cluster_tolerance);
+    assert!(
+        split > 0.9 * near && split < 1.1 * near,
+        "the near disc only: {split} m^2 of {near}"
+    );
+}

@@ -156,7 +156,13 @@ impl<'p> Detector<'p> {
                 .iter()
                 .map(|p| frame.to_local(p.as_dvec3()))
                 .collect();
-            let (comp, sizes) = clusterer.clusters(&flat, p.cluster_tolerance);
+            // The ground, seen at grazing angles, has its own tolerance.
+            let tol = if plane.ground {
+                p.ground_cluster_tolerance
+            } else {
+                p.cluster_tolerance
+            };
+            let (comp, sizes) = clusterer.clusters(&flat, tol);
             let largest = comp
                 .iter()
                 .copied()

@@ -58,6 +58,9 @@ pub struct LocalPlane {
     pub offset: f64,
     /// Inlier distance used (m).
     pub threshold: f64,
+    /// Counted as ground (near-horizontal, at least `ground_depth` below
+    /// the viewpoint): `threshold` is then `ground_distance`.
+    pub ground: bool,
 }
 
 /// The points not yet explained, and the sampling structures over them.
@@ -290,12 +293,18 @@ impl PlanePool {
         // Prefixes run over the pool arrays, dead (NaN) entries included.
         let n = self.ridx.len();
         let tilt_cos = libm::cos(params.ground_max_tilt.to_radians());
-        let threshold_for = |normal: DVec3, offset: f64| {
+        let plane_for = |normal: DVec3, offset: f64| {
             let depth = (normal.dot(viewpoint) + offset) * normal.z.signum();
-            if normal.z.abs() >= tilt_cos && depth > params.ground_depth {
-                params.ground_distance
-            } else {
-                params.distance
+            let ground = normal.z.abs() >= tilt_cos && depth > params.ground_depth;
+            LocalPlane {
+                normal,
+                offset,
+                threshold: if ground {
+                    params.ground_distance
+                } else {
+                    params.distance
+                },
+                ground,
             }
         };
         let mut k = n.min(START_K);
@@ -308,11 +317,7 @@ impl PlanePool {
                 let Some((normal, offset, cell)) = self.sample() else {
                     continue;
                 };
-                let plane = LocalPlane {
-                    normal,
-                    offset,
-                    threshold: threshold_for(normal, offset),
-                };
+                let plane = plane_for(normal, offset);
                 // Cheap local test: the plane must explain a fair share of
                 // its own voxel, or the sample mixed surfaces / hit clutter.
                 if !self.locally_planar(&plane, cell) {
@@ -340,11 +345,8 @@ impl PlanePool {
         let sample = self.collect_prefix(&best, lo_k);
         let mut plane = best;
         if sample.len() >= 3 {
-            if let Some(refit) = self.refit(&sample) {
-                let refit = LocalPlane {
-                    threshold: threshold_for(refit.normal, refit.offset),
-                    ..refit
-                };
+            if let Some((normal, offset)) = self.refit(&sample) {
+                let refit = plane_for(normal, offset);
                 // Keep the refit when it scores at least as well on the
                 // subsample, both scored with the hypothesis's threshold.
                 self.work += 2 * lo_k as u64;
@@ -571,7 +573,7 @@ impl PlanePool {
     /// deviations (1.4826 x median absolute residual) of the last plane. A
     /// tilted hypothesis that caught a road and the edge of its sidewalk
     /// converges to the road, the majority.
-    fn refit(&self, positions: &[u32]) -> Option<LocalPlane> {
+    fn refit(&self, positions: &[u32]) -> Option<(DVec3, f64)> {
         let at = |p: u32| {
             let p = p as usize;
             DVec3::new(self.rx[p] as f64, self.ry[p] as f64, self.rz[p] as f64)
@@ -603,11 +605,7 @@ impl PlanePool {
                 None => break,
             }
         }
-        Some(LocalPlane {
-            normal: plane.normal,
-            offset: plane.offset,
-            threshold: 0.0,
-        })
+        Some((plane.normal, plane.offset))
     }
 }
 

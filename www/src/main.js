@@ -15,8 +15,8 @@ import { idCss } from './palette.js';
 // resets them. Replaced by the library's own defaultOptions() as soon as the
 // worker has loaded it (these are src/params.rs's values, for the first run).
 const PRESETS = {
-  gpp2: { distance: 0.1, minArea: 1.5, alpha: 0.5, clusterTolerance: 0.5 },
-  gpp1: { distance: 0.1, minArea: 7.0, alpha: 0.5, clusterTolerance: 0.5 },
+  gpp2: { distance: 0.1, minArea: 1.5, alpha: 0.5, clusterTolerance: 0.5, groundClusterTolerance: 0.5 },
+  gpp1: { distance: 0.1, minArea: 7.0, alpha: 0.5, clusterTolerance: 0.5, groundClusterTolerance: 0.5 },
 };
 
 // The scans shipped with the page (www/data, licences next to them).
@@ -310,6 +310,10 @@ class App {
     det.add(this.options, 'minArea', 0.25, 20, 0.25).name('min area (m²)').onFinishChange(restart);
     det.add(this.options, 'alpha', 0.1, 3, 0.05).name('alpha (m)').onFinishChange(restart);
     det.add(this.options, 'clusterTolerance', 0.1, 2, 0.05).name('cluster tol. (m)').onFinishChange(restart);
+    det
+      .add(this.options, 'groundClusterTolerance', 0.1, 2, 0.05)
+      .name('ground cluster tol. (m)')
+      .onFinishChange(restart);
     det.add(this.options, 'seed', 0, 999, 1).name('RANSAC seed').onFinishChange(restart);
 
     const view = gui.addFolder('View');
