@@ -387,14 +387,11 @@ pub fn voxelise(pts: &[glam::Vec3], voxel: f64) -> Voxels {
     );
     let mut finite = true;
     for p in pts {
-        // f32 comparisons per lane (f32::min/max are library calls in wasm).
+        // f32 comparisons per lane as selects (f32::min/max are library
+        // calls in wasm; branches mispredict while the box grows).
         for k in 0..3 {
-            if p[k] < plo[k] {
-                plo[k] = p[k];
-            }
-            if p[k] > phi[k] {
-                phi[k] = p[k];
-            }
+            plo[k] = if p[k] < plo[k] { p[k] } else { plo[k] };
+            phi[k] = if p[k] > phi[k] { p[k] } else { phi[k] };
         }
         finite &= p.is_finite();
     }

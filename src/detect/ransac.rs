@@ -95,7 +95,7 @@ pub struct PlanePool {
     /// Points still in play.
     live: usize,
     /// Of those, how many are in the scoring pool (whose arrays may also
-    /// hold dead ones, as NaN).
+    /// hold dead ones, with x = NaN).
     pool_live: usize,
     /// Pool position of each position (`u32::MAX` when not in the pool).
     pos_of: Vec<u32>,
@@ -225,10 +225,13 @@ impl PlanePool {
         self.ridx = order;
     }
 
-    /// Take these positions out of play. Their coordinates in the
-    /// pool become NaN, which fails every inlier test, so no pass over the
-    /// pool needs to check liveness; the arrays are compacted only once half
-    /// of them is dead (which keeps the order, so prefixes stay random).
+    /// Take these positions out of play. Their x coordinate in the pool
+    /// becomes NaN: every distance computed from it is NaN (a zero normal
+    /// component times NaN is still NaN), which fails every inlier test, so
+    /// no pass over the pool needs to check liveness. Only x: the pool is in
+    /// random order, so each write is a cache miss, one per point instead of
+    /// three. The arrays are compacted only once half of them is dead (which
+    /// keeps the order, so prefixes stay random).
     pub fn remove(&mut self, originals: &[u32]) {
         for &i in originals {
             if !self.alive[i as usize] {
@@ -242,8 +245,6 @@ impl PlanePool {
             if pos != u32::MAX {
                 let pos = pos as usize;
                 self.rx[pos] = f32::NAN;
-                self.ry[pos] = f32::NAN;
-                self.rz[pos] = f32::NAN;
                 self.pool_live -= 1;
             }
         }
