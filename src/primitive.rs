@@ -164,13 +164,30 @@ pub(crate) struct Shaped {
     /// the inlier slab (a plane cutting through objects), far less for a
     /// surface.
     pub roughness: f64,
+    /// Frame coordinates of every support point (for
+    /// [`Shaped::consistency`]).
+    q: Vec<DVec2>,
+}
+
+impl Shaped {
     /// Share of the support's local patches (cells of `2 x cell`) whose own
     /// PCA normal lies within 15 degrees of the plane's: ~1 for a surface,
     /// low for a plane cutting through crossing surfaces (a horizontal slab
     /// through a car's sides, whose laser rings look flat from afar, or a
     /// plane tilted across a curb). 1 when no patch has a well-defined
-    /// normal.
-    pub consistency: f64,
+    /// normal. `origin` and `pts` are what [`shape`] was given. Computed on
+    /// demand: it is the costliest acceptance test (a plane fit per patch),
+    /// so the cascade asks for it only when every other test passed.
+    pub fn consistency(&self, origin: DVec3, pts: &[Vec3], params: &Params) -> f64 {
+        normal_consistency(
+            origin,
+            pts,
+            &self.q,
+            &self.kept,
+            &self.primitive.frame,
+            2.0 * params.cell,
+        )
+    }
 }
 
 /// See [`Shaped::consistency`].
@@ -361,7 +378,6 @@ pub(crate) fn shape(
         nk += 1;
     }
     let roughness = (sq / nk.max(1) as f64).sqrt() / threshold;
-    let consistency = normal_consistency(origin, pts, &q, &kept, &frame, 2.0 * params.cell);
     Some(Shaped {
         primitive: Primitive {
             id: 0,
@@ -378,6 +394,6 @@ pub(crate) fn shape(
         },
         kept,
         roughness,
-        consistency,
+        q,
     })
 }

@@ -214,8 +214,8 @@ impl<'p> Detector<'p> {
                 Some(s)
                     if s.primitive.acceptable(p)
                         && s.roughness <= p.max_roughness
-                        && s.consistency >= p.min_normal_consistency
-                        && !seen_edge_on(&s, viewpoint, p) =>
+                        && !seen_edge_on(&s, viewpoint, p)
+                        && s.consistency(origin, &support_pts, p) >= p.min_normal_consistency =>
                 {
                     let id = primitives.len() as u32;
                     let taken: Vec<u32> = cluster
