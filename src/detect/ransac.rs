@@ -667,9 +667,8 @@ fn hypotheses_needed(p: f64, confidence: f64) -> usize {
 mod tests {
     use super::*;
 
-    /// A 10 m square of floor (z = 0) under 40 % of points scattered
-    /// through a 10 m cube: the floor's own plane, a plane 0.3 m above it
-    /// and a plane tilted 20 degrees through it.
+    /// A 10 x 9.4 m floor (z = 0, 6000 points) and 4000 points scattered
+    /// through a 10 m cube above it.
     fn pool() -> PlanePool {
         let mut rng = Rng::new(3);
         let mut pts = Vec::new();
