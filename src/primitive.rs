@@ -297,10 +297,9 @@ pub(crate) fn shape(
         }
     }
     let plane = fit.oriented(viewpoint);
-    // Ground: near-horizontal, facing up, well below the sensor.
-    let ground = plane.is_horizontal(tilt)
-        && plane.normal.z > 0.0
-        && plane.signed_distance(viewpoint) > params.ground_depth;
+    // Ground: near-horizontal, well below the sensor (then, oriented
+    // towards the sensor, facing up).
+    let ground = plane.is_ground_below(viewpoint, libm::cos(tilt), params.ground_depth);
     let frame = Frame::on_plane(&plane, moments.mean());
     // Support is what lies within the inlier distance of the final plane.
     let threshold = if ground {

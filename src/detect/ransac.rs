@@ -49,7 +49,7 @@
 //! Every evaluation is counted in `work` so the cascade can enforce
 //! `Params::max_work`.
 
-use crate::geometry::Moments;
+use crate::geometry::{Moments, Plane};
 use crate::hash::Buckets;
 use crate::params::Params;
 use crate::rng::Rng;
@@ -242,8 +242,8 @@ impl PlanePool {
     /// random order, so each write is a cache miss, one per point instead of
     /// three. The arrays are compacted only once half of them is dead (which
     /// keeps the order, so prefixes stay random).
-    pub fn remove(&mut self, originals: &[u32]) {
-        for &i in originals {
+    pub fn remove(&mut self, positions: &[u32]) {
+        for &i in positions {
             if !self.alive[i as usize] {
                 continue;
             }
@@ -305,8 +305,8 @@ impl PlanePool {
         let n = self.ridx.len();
         let tilt_cos = libm::cos(params.ground_max_tilt.to_radians());
         let plane_for = |normal: DVec3, offset: f64| {
-            let depth = (normal.dot(viewpoint) + offset) * normal.z.signum();
-            let ground = normal.z.abs() >= tilt_cos && depth > params.ground_depth;
+            let ground =
+                Plane { normal, offset }.is_ground_below(viewpoint, tilt_cos, params.ground_depth);
             LocalPlane {
                 normal,
                 offset,

@@ -40,6 +40,18 @@ impl Plane {
         self.normal.dot(UP).abs() >= libm::cos(max_tilt)
     }
 
+    /// Is the plane ground as seen from `viewpoint`: near-horizontal (the
+    /// cosine of its tilt at least `min_cos`) with the viewpoint more than
+    /// `depth` above it? Either orientation of the normal gives the same
+    /// answer. The one ground test of detection: RANSAC picks the inlier
+    /// distance and clustering tolerance by it, and shaping marks ground
+    /// primitives by it. Takes the cosine, which RANSAC computes once per
+    /// round, not once per hypothesis.
+    pub fn is_ground_below(&self, viewpoint: DVec3, min_cos: f64, depth: f64) -> bool {
+        self.normal.z.abs() >= min_cos
+            && self.signed_distance(viewpoint) * self.normal.z.signum() > depth
+    }
+
     /// The same plane with the normal flipped when needed so that it points
     /// towards `viewpoint` (the side the sensor saw it from). A plane through
     /// the viewpoint itself keeps a normal pointing up (or is left as is
@@ -313,6 +325,34 @@ pub fn symmetric_eigen3(m: [[f64; 3]; 3]) -> ([f64; 3], [DVec3; 3]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn ground_below_the_viewpoint_whichever_way_the_normal_points() {
+        let cos15 = libm::cos(15f64.to_radians());
+        let up = Plane {
+            normal: UP,
+            offset: 0.0,
+        };
+        let down = Plane {
+            normal: -UP,
+            offset: 0.0,
+        };
+        let sensor = DVec3::new(3.0, -2.0, 1.8);
+        for p in [up, down] {
+            assert!(p.is_ground_below(sensor, cos15, 1.3));
+            // Too close below the sensor, or above it: not ground.
+            assert!(!p.is_ground_below(DVec3::new(0.0, 0.0, 1.0), cos15, 1.3));
+            assert!(!p.is_ground_below(DVec3::new(0.0, 0.0, -1.8), cos15, 1.3));
+        }
+        // Tilted 20 degrees: a ramp too steep to be ground.
+        let a = 20f64.to_radians();
+        let ramp = Plane {
+            normal: DVec3::new(libm::sin(a), 0.0, libm::cos(a)),
+            offset: 0.0,
+        };
+        assert!(!ramp.is_ground_below(sensor, cos15, 1.3));
+        assert!(ramp.is_ground_below(sensor, libm::cos(25f64.to_radians()), 1.3));
+    }
 
     #[test]
     fn pca_recovers_a_tilted_plane_far_from_origin() {
