@@ -3,6 +3,7 @@
 //! acceptance tests, each round removing what it explained.
 
 pub mod cluster;
+pub mod kernels;
 pub mod ransac;
 
 use crate::clock;

@@ -49,6 +49,7 @@
 //! Every evaluation is counted in `work` so the cascade can enforce
 //! `Params::max_work`.
 
+use super::kernels::{self, PlaneF32};
 use crate::geometry::{Moments, Plane};
 use crate::hash::Buckets;
 use crate::params::Params;
@@ -68,6 +69,18 @@ pub struct LocalPlane {
     /// Counted as ground (near-horizontal, at least `ground_depth` below
     /// the viewpoint): `threshold` is then `ground_distance`.
     pub ground: bool,
+}
+
+impl LocalPlane {
+    /// The plane in f32, as the kernels test points against it.
+    fn as_f32(&self) -> PlaneF32 {
+        PlaneF32 {
+            nx: self.normal.x as f32,
+            ny: self.normal.y as f32,
+            nz: self.normal.z as f32,
+            d: self.offset as f32,
+        }
+    }
 }
 
 /// The points not yet explained, and the sampling structures over them.
@@ -457,30 +470,9 @@ impl PlanePool {
     /// soft inlier count: a plane through the middle of a surface scores
     /// close to its inlier count, one tilted across two surfaces far less.
     fn count(&self, plane: &LocalPlane, lo: usize, hi: usize) -> f64 {
-        let (nx, ny, nz) = (
-            plane.normal.x as f32,
-            plane.normal.y as f32,
-            plane.normal.z as f32,
-        );
-        let (d, inv) = (plane.offset as f32, (1.0 / plane.threshold) as f32);
+        let inv = (1.0 / plane.threshold) as f32;
         let (xs, ys, zs) = (&self.rx[lo..hi], &self.ry[lo..hi], &self.rz[lo..hi]);
-        let mut acc = [0f32; 8];
-        let (cx, cy, cz) = (xs.chunks_exact(8), ys.chunks_exact(8), zs.chunks_exact(8));
-        let (tx, ty, tz) = (cx.remainder(), cy.remainder(), cz.remainder());
-        for ((x, y), z) in cx.zip(cy).zip(cz) {
-            for l in 0..8 {
-                let v = (nx * x[l] + ny * y[l] + nz * z[l] + d) * inv;
-                let w = 1.0 - v * v;
-                acc[l] += if w > 0.0 { w } else { 0.0 };
-            }
-        }
-        let mut c: f64 = acc.iter().map(|&a| a as f64).sum();
-        for i in 0..tx.len() {
-            let v = (nx * tx[i] + ny * ty[i] + nz * tz[i] + d) * inv;
-            let w = 1.0 - v * v;
-            c += (if w > 0.0 { w } else { 0.0 }) as f64;
-        }
-        c
+        kernels::msac_sum(xs, ys, zs, plane.as_f32(), inv)
     }
 
     /// MSAC score of `plane` over the first `k` pool entries, or an
@@ -563,37 +555,17 @@ impl PlanePool {
     /// that vectorises like [`PlanePool::count`]), then the set bits are
     /// listed; inliers are a minority, so most masks are sparse or empty.
     fn inliers_in(&self, plane: &LocalPlane, k: usize) -> Vec<u32> {
-        let (nx, ny, nz) = (
-            plane.normal.x as f32,
-            plane.normal.y as f32,
-            plane.normal.z as f32,
-        );
-        let (d, t) = (plane.offset as f32, plane.threshold as f32);
         let mut out = Vec::new();
         let (xs, ys, zs) = (&self.rx[..k], &self.ry[..k], &self.rz[..k]);
-        let (cx, cy, cz) = (
-            xs.chunks_exact(64),
-            ys.chunks_exact(64),
-            zs.chunks_exact(64),
+        kernels::inliers(
+            xs,
+            ys,
+            zs,
+            plane.as_f32(),
+            plane.threshold as f32,
+            0,
+            &mut out,
         );
-        let tail = cx.remainder().len();
-        for (c, ((x, y), z)) in cx.zip(cy).zip(cz).enumerate() {
-            let mut m = 0u64;
-            for l in 0..64 {
-                let v = nx * x[l] + ny * y[l] + nz * z[l] + d;
-                m |= ((v.abs() < t) as u64) << l;
-            }
-            while m != 0 {
-                out.push((c * 64) as u32 + m.trailing_zeros());
-                m &= m - 1;
-            }
-        }
-        for i in k - tail..k {
-            let v = nx * xs[i] + ny * ys[i] + nz * zs[i] + d;
-            if v.abs() < t {
-                out.push(i as u32);
-            }
-        }
         out
     }
 
