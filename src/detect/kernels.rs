@@ -235,7 +235,8 @@ mod x86 {
         finish(&acc, &xs[body..], &ys[body..], &zs[body..], p, inv)
     }
 
-    /// [`super::inliers_scalar`] eight tests at a time.
+    /// [`super::inliers_scalar`] eight tests at a time (short ranges,
+    /// like one voxel's points, gain as much as long ones).
     ///
     /// # Safety
     /// The CPU must support AVX.
@@ -249,7 +250,7 @@ mod x86 {
         base: u32,
         out: &mut Vec<u32>,
     ) {
-        let body = xs.len() / 64 * 64;
+        let body = xs.len() / 8 * 8;
         let (vx, vy, vz) = (
             _mm256_set1_ps(p.nx),
             _mm256_set1_ps(p.ny),
@@ -257,27 +258,26 @@ mod x86 {
         );
         let (vd, vt) = (_mm256_set1_ps(p.d), _mm256_set1_ps(t));
         let sign = _mm256_set1_ps(-0.0);
-        let mut start = 0;
-        while start < body {
-            let mut m = 0u64;
-            for j in 0..8 {
-                let o = start + 8 * j;
-                // SAFETY: o + 8 <= body <= len of all three slices.
-                let (x, y, z) = unsafe {
-                    (
-                        _mm256_loadu_ps(xs[o..o + 8].as_ptr()),
-                        _mm256_loadu_ps(ys[o..o + 8].as_ptr()),
-                        _mm256_loadu_ps(zs[o..o + 8].as_ptr()),
-                    )
-                };
-                let s = _mm256_add_ps(_mm256_mul_ps(vx, x), _mm256_mul_ps(vy, y));
-                let v = _mm256_add_ps(_mm256_add_ps(s, _mm256_mul_ps(vz, z)), vd);
-                // |v| < t, ordered: NaN compares false.
-                let c = _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_andnot_ps(sign, v), vt);
-                m |= (_mm256_movemask_ps(c) as u32 as u64) << (8 * j);
-            }
-            push_bits(m, base + start as u32, out);
-            start += 64;
+        for (j, ((x, y), z)) in xs[..body]
+            .chunks_exact(8)
+            .zip(ys[..body].chunks_exact(8))
+            .zip(zs[..body].chunks_exact(8))
+            .enumerate()
+        {
+            // SAFETY: each load reads one chunk of exactly 8 floats.
+            let (x, y, z) = unsafe {
+                (
+                    _mm256_loadu_ps(x.as_ptr()),
+                    _mm256_loadu_ps(y.as_ptr()),
+                    _mm256_loadu_ps(z.as_ptr()),
+                )
+            };
+            let s = _mm256_add_ps(_mm256_mul_ps(vx, x), _mm256_mul_ps(vy, y));
+            let v = _mm256_add_ps(_mm256_add_ps(s, _mm256_mul_ps(vz, z)), vd);
+            // |v| < t, ordered: NaN compares false.
+            let c = _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_andnot_ps(sign, v), vt);
+            let m = _mm256_movemask_ps(c) as u32 as u64;
+            push_bits(m, base + 8 * j as u32, out);
         }
         super::inliers_scalar(
             &xs[body..],
@@ -349,25 +349,23 @@ mod wasm {
         base: u32,
         out: &mut Vec<u32>,
     ) {
-        let body = xs.len() / 64 * 64;
+        let body = xs.len() / 8 * 8;
         let (vx, vy, vz) = (f32x4_splat(p.nx), f32x4_splat(p.ny), f32x4_splat(p.nz));
         let (vd, vt) = (f32x4_splat(p.d), f32x4_splat(t));
-        let mut start = 0;
-        while start < body {
-            let mut m = 0u64;
-            for j in 0..16 {
-                let o = start + 4 * j;
-                let s = f32x4_add(
-                    f32x4_mul(vx, load(&xs[o..o + 4])),
-                    f32x4_mul(vy, load(&ys[o..o + 4])),
-                );
-                let v = f32x4_add(f32x4_add(s, f32x4_mul(vz, load(&zs[o..o + 4]))), vd);
-                // |v| < t: NaN compares false.
-                let c = f32x4_lt(f32x4_abs(v), vt);
-                m |= (i32x4_bitmask(c) as u64) << (4 * j);
-            }
-            push_bits(m, base + start as u32, out);
-            start += 64;
+        let test = |x: &[f32], y: &[f32], z: &[f32]| {
+            let s = f32x4_add(f32x4_mul(vx, load(x)), f32x4_mul(vy, load(y)));
+            let v = f32x4_add(f32x4_add(s, f32x4_mul(vz, load(z))), vd);
+            // |v| < t: NaN compares false.
+            i32x4_bitmask(f32x4_lt(f32x4_abs(v), vt)) as u64
+        };
+        for (j, ((x, y), z)) in xs[..body]
+            .chunks_exact(8)
+            .zip(ys[..body].chunks_exact(8))
+            .zip(zs[..body].chunks_exact(8))
+            .enumerate()
+        {
+            let m = test(x, y, z) | test(&x[4..], &y[4..], &z[4..]) << 4;
+            push_bits(m, base + 8 * j as u32, out);
         }
         super::inliers_scalar(
             &xs[body..],
