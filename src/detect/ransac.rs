@@ -575,34 +575,33 @@ impl PlanePool {
     /// tilted hypothesis that caught a road and the edge of its sidewalk
     /// converges to the road, the majority.
     fn refit(&self, positions: &[u32]) -> Option<(DVec3, f64)> {
-        let at = |p: u32| {
-            let p = p as usize;
-            DVec3::new(self.rx[p] as f64, self.ry[p] as f64, self.rz[p] as f64)
-        };
-        let reference = at(positions[0]);
-        let fit = |keep: &dyn Fn(u32) -> bool| {
-            let mut m = Moments::new(reference);
-            for &p in positions {
-                if keep(p) {
-                    m.push(at(p));
-                }
-            }
-            m.fit_plane().map(|(plane, _)| plane)
-        };
-        let mut plane = fit(&|_| true)?;
-        let mut resid: Vec<f64> = Vec::with_capacity(positions.len());
+        let pts: Vec<DVec3> = positions
+            .iter()
+            .map(|&p| {
+                let p = p as usize;
+                DVec3::new(self.rx[p] as f64, self.ry[p] as f64, self.rz[p] as f64)
+            })
+            .collect();
+        let reference = *pts.first()?;
+        let mut m = Moments::new(reference);
+        pts.iter().for_each(|&p| m.push(p));
+        let mut plane = m.fit_plane()?.0;
+        let (mut resid, mut scratch) = (Vec::with_capacity(pts.len()), Vec::new());
         for _ in 0..3 {
             resid.clear();
-            resid.extend(
-                positions
-                    .iter()
-                    .map(|&p| plane.signed_distance(at(p)).abs()),
-            );
-            let mid = resid.len() / 2;
-            let med = *resid.clone().select_nth_unstable_by(mid, f64::total_cmp).1;
+            resid.extend(pts.iter().map(|&p| plane.signed_distance(p).abs()));
+            scratch.clone_from(&resid);
+            let mid = scratch.len() / 2;
+            let med = *scratch.select_nth_unstable_by(mid, f64::total_cmp).1;
             let cut = (2.5 * 1.4826 * med).max(1e-4);
-            match fit(&|p| plane.signed_distance(at(p)).abs() <= cut) {
-                Some(next) => plane = next,
+            let mut m = Moments::new(reference);
+            for (&p, &r) in pts.iter().zip(&resid) {
+                if r <= cut {
+                    m.push(p);
+                }
+            }
+            match m.fit_plane() {
+                Some((next, _)) => plane = next,
                 None => break,
             }
         }
