@@ -58,6 +58,7 @@ pub struct Clusterer {
 
 impl Clusterer {
     /// See [`clusters`].
+    #[inline(never)]
     pub fn clusters(&mut self, points: &[DVec2], tol: f64) -> (Vec<u32>, Vec<u32>) {
         let n = points.len();
         if n == 0 {
@@ -114,10 +115,19 @@ impl Clusterer {
         for c in 0..cells {
             let (cx, cy) = self.ids.keys[c];
             let a = self.buckets.of(c);
+            // The occupied neighbours first, without a branch per empty one
+            // (most are empty, in no predictable pattern).
+            let mut found = [0u32; 12];
+            let mut count = 0;
             for &(dx, dy) in &offsets {
-                let Some(nb) = self.ids.get(cx.wrapping_add(dx), cy.wrapping_add(dy)) else {
-                    continue;
-                };
+                let nb = self
+                    .ids
+                    .get(cx.wrapping_add(dx), cy.wrapping_add(dy))
+                    .unwrap_or(u32::MAX);
+                found[count] = nb;
+                count += (nb != u32::MAX) as usize;
+            }
+            for &nb in &found[..count] {
                 let (ra, rb) = (find(parent, c as u32), find(parent, nb));
                 if ra == rb {
                     continue;
