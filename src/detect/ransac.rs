@@ -232,16 +232,21 @@ impl PlanePool {
         self.set_pool(order);
     }
 
-    /// Make these (live) positions the scoring pool, in this order.
+    /// Make these (live) positions the scoring pool, in this order. Two
+    /// passes: gathering the coordinates and scattering the positions in
+    /// one loop ran at half the speed (each stalls the other's misses).
     fn set_pool(&mut self, order: Vec<u32>) {
-        self.rx.clear();
-        self.ry.clear();
-        self.rz.clear();
-        for (pos, &i) in order.iter().enumerate() {
+        for v in [&mut self.rx, &mut self.ry, &mut self.rz] {
+            v.clear();
+            v.reserve(order.len());
+        }
+        for &i in &order {
             let p = self.cell_pts[i as usize];
             self.rx.push(p.x);
             self.ry.push(p.y);
             self.rz.push(p.z);
+        }
+        for (pos, &i) in order.iter().enumerate() {
             self.pos_of[i as usize] = pos as u32;
         }
         self.pool_live = order.len();
