@@ -250,7 +250,6 @@ mod x86 {
         base: u32,
         out: &mut Vec<u32>,
     ) {
-        let body = xs.len() / 8 * 8;
         let (vx, vy, vz) = (
             _mm256_set1_ps(p.nx),
             _mm256_set1_ps(p.ny),
@@ -258,27 +257,38 @@ mod x86 {
         );
         let (vd, vt) = (_mm256_set1_ps(p.d), _mm256_set1_ps(t));
         let sign = _mm256_set1_ps(-0.0);
-        for (j, ((x, y), z)) in xs[..body]
-            .chunks_exact(8)
-            .zip(ys[..body].chunks_exact(8))
-            .zip(zs[..body].chunks_exact(8))
-            .enumerate()
-        {
-            // SAFETY: each load reads one chunk of exactly 8 floats.
+        // Bit l of the mask: point `o + l` is an inlier.
+        let mask8 = |o: usize| {
+            // SAFETY: callers pass o + 8 <= len of all three slices.
             let (x, y, z) = unsafe {
                 (
-                    _mm256_loadu_ps(x.as_ptr()),
-                    _mm256_loadu_ps(y.as_ptr()),
-                    _mm256_loadu_ps(z.as_ptr()),
+                    _mm256_loadu_ps(xs[o..o + 8].as_ptr()),
+                    _mm256_loadu_ps(ys[o..o + 8].as_ptr()),
+                    _mm256_loadu_ps(zs[o..o + 8].as_ptr()),
                 )
             };
             let s = _mm256_add_ps(_mm256_mul_ps(vx, x), _mm256_mul_ps(vy, y));
             let v = _mm256_add_ps(_mm256_add_ps(s, _mm256_mul_ps(vz, z)), vd);
             // |v| < t, ordered: NaN compares false.
             let c = _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_andnot_ps(sign, v), vt);
-            let m = _mm256_movemask_ps(c) as u32 as u64;
-            push_bits(m, base + 8 * j as u32, out);
+            _mm256_movemask_ps(c) as u32 as u64
+        };
+        // Blocks of 64 into one mask (one bit-listing loop per 64 points:
+        // its exit is the branch that mispredicts), then blocks of 8.
+        let (n, mut o) = (xs.len(), 0);
+        while o + 64 <= n {
+            let mut m = 0u64;
+            for j in 0..8 {
+                m |= mask8(o + 8 * j) << (8 * j);
+            }
+            push_bits(m, base + o as u32, out);
+            o += 64;
         }
+        while o + 8 <= n {
+            push_bits(mask8(o), base + o as u32, out);
+            o += 8;
+        }
+        let body = o;
         super::inliers_scalar(
             &xs[body..],
             &ys[body..],
@@ -349,24 +359,30 @@ mod wasm {
         base: u32,
         out: &mut Vec<u32>,
     ) {
-        let body = xs.len() / 8 * 8;
         let (vx, vy, vz) = (f32x4_splat(p.nx), f32x4_splat(p.ny), f32x4_splat(p.nz));
         let (vd, vt) = (f32x4_splat(p.d), f32x4_splat(t));
-        let test = |x: &[f32], y: &[f32], z: &[f32]| {
-            let s = f32x4_add(f32x4_mul(vx, load(x)), f32x4_mul(vy, load(y)));
-            let v = f32x4_add(f32x4_add(s, f32x4_mul(vz, load(z))), vd);
+        // Bit l of the mask: point `o + l` is an inlier (o + 4 <= len).
+        let mask4 = |o: usize| {
+            let s = f32x4_add(f32x4_mul(vx, load(&xs[o..])), f32x4_mul(vy, load(&ys[o..])));
+            let v = f32x4_add(f32x4_add(s, f32x4_mul(vz, load(&zs[o..]))), vd);
             // |v| < t: NaN compares false.
             i32x4_bitmask(f32x4_lt(f32x4_abs(v), vt)) as u64
         };
-        for (j, ((x, y), z)) in xs[..body]
-            .chunks_exact(8)
-            .zip(ys[..body].chunks_exact(8))
-            .zip(zs[..body].chunks_exact(8))
-            .enumerate()
-        {
-            let m = test(x, y, z) | test(&x[4..], &y[4..], &z[4..]) << 4;
-            push_bits(m, base + 8 * j as u32, out);
+        // As on x86: blocks of 64 into one mask, then blocks of 8.
+        let (n, mut o) = (xs.len(), 0);
+        while o + 64 <= n {
+            let mut m = 0u64;
+            for j in 0..16 {
+                m |= mask4(o + 4 * j) << (4 * j);
+            }
+            push_bits(m, base + o as u32, out);
+            o += 64;
         }
+        while o + 8 <= n {
+            push_bits(mask4(o) | mask4(o + 4) << 4, base + o as u32, out);
+            o += 8;
+        }
+        let body = o;
         super::inliers_scalar(
             &xs[body..],
             &ys[body..],
