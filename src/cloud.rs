@@ -80,11 +80,16 @@ impl Cloud {
     /// From a flat f32 buffer (stride 3 or 4), world frame.
     pub fn from_flat(values: &[f32], stride: usize) -> Result<Self> {
         check_finite(values, stride)?;
-        let pts: Vec<DVec3> = values
-            .chunks_exact(stride)
-            .map(|p| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
-            .collect();
-        Self::from_world_f64(&pts)
+        // What `from_world_f64` computes, without an f64 copy of the cloud.
+        let at = |p: &[f32]| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
+        let origin = bbox_centre(values.chunks_exact(stride).map(at)).round();
+        Ok(Cloud {
+            origin,
+            points: values
+                .chunks_exact(stride)
+                .map(|p| (at(p) - origin).as_vec3())
+                .collect(),
+        })
     }
 
     /// From a flat f32 buffer in a sensor frame and a world-from-sensor pose:
@@ -126,8 +131,9 @@ fn bbox_centre(points: impl Iterator<Item = DVec3>) -> DVec3 {
     let mut hi = DVec3::splat(f64::NEG_INFINITY);
     let mut any = false;
     for p in points {
-        lo = lo.min(p);
-        hi = hi.max(p);
+        // By selects: `f64::min`/`max` are library calls in wasm (the
+        // points are finite here, so the results are the same).
+        crate::geometry::grow_box(&mut lo, &mut hi, p);
         any = true;
     }
     if any {
