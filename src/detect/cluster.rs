@@ -127,8 +127,11 @@ impl Clusterer {
                 found[count] = nb;
                 count += (nb != u32::MAX) as usize;
             }
+            // This cell's root, found once: only a union below changes it
+            // (to the smaller of the two roots).
+            let mut ra = if count > 0 { find(parent, c as u32) } else { 0 };
             for &nb in &found[..count] {
-                let (ra, rb) = (find(parent, c as u32), find(parent, nb));
+                let rb = find(parent, nb);
                 if ra == rb {
                     continue;
                 }
@@ -150,6 +153,7 @@ impl Clusterer {
                 if quick {
                     let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
                     parent[hi as usize] = lo;
+                    ra = lo;
                     continue;
                 }
                 near.clear();
@@ -168,6 +172,7 @@ impl Clusterer {
                     // Union by smaller root id: deterministic.
                     let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
                     parent[hi as usize] = lo;
+                    ra = lo;
                 }
             }
         }
