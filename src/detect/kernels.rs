@@ -147,6 +147,43 @@ pub fn inliers_scalar(
     }
 }
 
+/// The block structure of every vector [`inliers`]: 64-point masks (one
+/// bit-listing loop per 64 points: its exit is the branch that
+/// mispredicts), then 8-point ones, then the reference for the tail.
+/// `mask8(o)` has bit `l` set when point `o + l` is an inlier; it is only
+/// called with `o + 8 <= xs.len()`.
+#[cfg(any(
+    target_arch = "x86_64",
+    all(target_arch = "wasm32", target_feature = "simd128")
+))]
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn list_blocks(
+    xs: &[f32],
+    ys: &[f32],
+    zs: &[f32],
+    p: PlaneF32,
+    t: f32,
+    base: u32,
+    out: &mut Vec<u32>,
+    mask8: impl Fn(usize) -> u64,
+) {
+    let (n, mut o) = (xs.len(), 0);
+    while o + 64 <= n {
+        let mut m = 0u64;
+        for j in 0..8 {
+            m |= mask8(o + 8 * j) << (8 * j);
+        }
+        push_bits(m, base + o as u32, out);
+        o += 64;
+    }
+    while o + 8 <= n {
+        push_bits(mask8(o), base + o as u32, out);
+        o += 8;
+    }
+    inliers_scalar(&xs[o..], &ys[o..], &zs[o..], p, t, base + o as u32, out);
+}
+
 #[inline(always)]
 fn push_bits(mut m: u64, base: u32, out: &mut Vec<u32>) {
     while m != 0 {
@@ -157,7 +194,7 @@ fn push_bits(mut m: u64, base: u32, out: &mut Vec<u32>) {
 
 #[cfg(target_arch = "x86_64")]
 mod x86 {
-    use super::{finish, push_bits, PlaneF32};
+    use super::{finish, PlaneF32};
     use std::arch::x86_64::*;
 
     /// [`super::msac_scalar`] with two 4-lane SSE2 accumulators (lanes
@@ -274,37 +311,13 @@ mod x86 {
             let c = _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_andnot_ps(sign, v), vt);
             _mm256_movemask_ps(c) as u32 as u64
         };
-        // Blocks of 64 into one mask (one bit-listing loop per 64 points:
-        // its exit is the branch that mispredicts), then blocks of 8.
-        let (n, mut o) = (xs.len(), 0);
-        while o + 64 <= n {
-            let mut m = 0u64;
-            for j in 0..8 {
-                m |= mask8(o + 8 * j) << (8 * j);
-            }
-            push_bits(m, base + o as u32, out);
-            o += 64;
-        }
-        while o + 8 <= n {
-            push_bits(mask8(o), base + o as u32, out);
-            o += 8;
-        }
-        let body = o;
-        super::inliers_scalar(
-            &xs[body..],
-            &ys[body..],
-            &zs[body..],
-            p,
-            t,
-            base + body as u32,
-            out,
-        );
+        super::list_blocks(xs, ys, zs, p, t, base, out, mask8);
     }
 }
 
 #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
 mod wasm {
-    use super::{finish, push_bits, PlaneF32};
+    use super::{finish, PlaneF32};
     use core::arch::wasm32::*;
 
     /// The first four floats of `s` (which must hold at least four).
@@ -369,30 +382,8 @@ mod wasm {
             // |v| < t: NaN compares false.
             i32x4_bitmask(f32x4_lt(f32x4_abs(v), vt)) as u64
         };
-        // As on x86: blocks of 64 into one mask, then blocks of 8.
-        let (n, mut o) = (xs.len(), 0);
-        while o + 64 <= n {
-            let mut m = 0u64;
-            for j in 0..16 {
-                m |= mask4(o + 4 * j) << (4 * j);
-            }
-            push_bits(m, base + o as u32, out);
-            o += 64;
-        }
-        while o + 8 <= n {
-            push_bits(mask4(o) | mask4(o + 4) << 4, base + o as u32, out);
-            o += 8;
-        }
-        let body = o;
-        super::inliers_scalar(
-            &xs[body..],
-            &ys[body..],
-            &zs[body..],
-            p,
-            t,
-            base + body as u32,
-            out,
-        );
+        let mask8 = |o: usize| mask4(o) | mask4(o + 4) << 4;
+        super::list_blocks(xs, ys, zs, p, t, base, out, mask8);
     }
 }
 
