@@ -193,3 +193,91 @@ fn the_simulator_runs() {
     let m = message(sim.scan(n as f64));
     assert!(m.contains("out of range"), "{m}");
 }
+
+/// The wasm build's own code paths against their portable references, bit
+/// for bit: the simd128 kernels of the RANSAC search (native builds run AVX
+/// or SSE2 against the same references) and `floor_i64` (`f64.floor` here).
+#[wasm_bindgen_test]
+fn wasm_paths_match_their_references() {
+    use polyscene::detect::kernels::{inliers, inliers_scalar, msac_scalar, msac_sum, PlaneF32};
+    use polyscene::hash::floor_i64;
+    // A pseudo-random slab of points around z = 0.5, with NaNs and -0.
+    let mut s = 0x9E37_79B9_7F4A_7C15u64;
+    let mut next = |scale: f32| {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        ((s >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0) as f32 * scale
+    };
+    let n = 1000;
+    let mut xs: Vec<f32> = (0..n).map(|_| next(20.0)).collect();
+    let ys: Vec<f32> = (0..n).map(|_| next(20.0)).collect();
+    let mut zs: Vec<f32> = (0..n).map(|_| 0.5 + next(0.2)).collect();
+    for i in (3..n).step_by(17) {
+        xs[i] = f32::NAN;
+    }
+    for i in (5..n).step_by(23) {
+        zs[i] = -0.0;
+    }
+    let plane = PlaneF32 {
+        nx: 0.01,
+        ny: -0.02,
+        nz: 0.999_75,
+        d: -0.5,
+    };
+    let mut listed = 0;
+    for len in (0..70).chain([999, 1000]) {
+        for start in [0, 3] {
+            let end = (start + len).min(n);
+            let (x, y, z) = (&xs[start..end], &ys[start..end], &zs[start..end]);
+            let (got, want) = (
+                msac_sum(x, y, z, plane, 10.0),
+                msac_scalar(x, y, z, plane, 10.0),
+            );
+            assert_eq!(
+                got.to_bits(),
+                want.to_bits(),
+                "msac len {len} start {start}"
+            );
+            let (mut got, mut want) = (Vec::new(), Vec::new());
+            inliers(x, y, z, plane, 0.1, 7, &mut got);
+            inliers_scalar(x, y, z, plane, 0.1, 7, &mut want);
+            assert_eq!(got, want, "inliers len {len} start {start}");
+            listed += got.len();
+        }
+    }
+    assert!(listed > 100, "{listed}");
+    // floor_i64 against the portable formula the native build uses.
+    let portable = |x: f64| {
+        let i = x as i64;
+        if (i as f64) > x {
+            i.saturating_sub(1)
+        } else {
+            i
+        }
+    };
+    for x in [
+        0.0,
+        -0.0,
+        0.5,
+        -0.5,
+        1.0,
+        -1.0,
+        2.999,
+        -2.999,
+        1e12 + 0.5,
+        -1e12 - 0.5,
+        7.0 / 3.0,
+        1e19,
+        -1e19,
+        9.3e18,
+        -9.3e18,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NAN,
+        4503599627370495.5,
+        -4503599627370495.5,
+    ] {
+        assert_eq!(floor_i64(x), portable(x), "{x}");
+    }
+}
