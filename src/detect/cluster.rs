@@ -58,7 +58,6 @@ pub struct Clusterer {
 
 impl Clusterer {
     /// See [`clusters`].
-    #[inline(never)]
     pub fn clusters(&mut self, points: &[DVec2], tol: f64) -> (Vec<u32>, Vec<u32>) {
         let n = points.len();
         if n == 0 {

@@ -474,6 +474,7 @@ impl PlanePool {
     /// the threshold counts `1 - (d/t)^2`, others (and dead entries) 0. A
     /// soft inlier count: a plane through the middle of a surface scores
     /// close to its inlier count, one tilted across two surfaces far less.
+    /// ([`kernels::msac_sum`]: the same bits on every target.)
     fn count(&self, plane: &LocalPlane, lo: usize, hi: usize) -> f64 {
         let inv = (1.0 / plane.threshold) as f32;
         let (xs, ys, zs) = (&self.rx[lo..hi], &self.ry[lo..hi], &self.rz[lo..hi]);
@@ -556,9 +557,8 @@ impl PlanePool {
     }
 
     /// Pool positions of the inliers of `plane` among the first `k` pool
-    /// entries: the test runs 64 entries at a time into a bit mask (a shape
-    /// that vectorises like [`PlanePool::count`]), then the set bits are
-    /// listed; inliers are a minority, so most masks are sparse or empty.
+    /// entries ([`kernels::inliers`]: 64 tests into a bit mask, then the set
+    /// bits; inliers are a minority, so most masks are sparse or empty).
     fn inliers_in(&self, plane: &LocalPlane, k: usize) -> Vec<u32> {
         let mut out = Vec::new();
         let (xs, ys, zs) = (&self.rx[..k], &self.ry[..k], &self.rz[..k]);
