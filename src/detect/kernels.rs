@@ -36,7 +36,18 @@ pub struct PlaneF32 {
 
 /// MSAC sum over the points `(xs[i], ys[i], zs[i])`: each point with
 /// `w = 1 - ((n · p + d) * inv)^2 > 0` adds `w` (a NaN coordinate adds 0).
-/// The three slices must have the same length (the shortest one rules).
+/// `inv` is one over the inlier distance. The three slices must have the
+/// same length (the shortest one rules). The scoring of RANSAC hypotheses
+/// (paper Algorithm 1, step 1), as a soft inlier count.
+///
+/// ```
+/// use polyscene::detect::kernels::{msac_sum, PlaneF32};
+/// // z = 0; points at heights 0, 0.05 and 0.2, inlier distance 0.1 m.
+/// let plane = PlaneF32 { nx: 0.0, ny: 0.0, nz: 1.0, d: 0.0 };
+/// let (xs, ys, zs) = ([0.0, 1.0, 2.0], [0.0; 3], [0.0, 0.05, 0.2]);
+/// let s = msac_sum(&xs, &ys, &zs, plane, 10.0);
+/// assert!((s - 1.75).abs() < 1e-6); // 1 + (1 - 0.5^2) + 0
+/// ```
 pub fn msac_sum(xs: &[f32], ys: &[f32], zs: &[f32], plane: PlaneF32, inv: f32) -> f64 {
     let n = xs.len().min(ys.len()).min(zs.len());
     let (xs, ys, zs) = (&xs[..n], &ys[..n], &zs[..n]);
@@ -96,6 +107,15 @@ fn finish(acc: &[f32; 8], tx: &[f32], ty: &[f32], tz: &[f32], p: PlaneF32, inv: 
 
 /// Append to `out` the indices `base + i` of the points with
 /// `|n · p + d| < t` (NaN coordinates never qualify), in increasing order.
+///
+/// ```
+/// use polyscene::detect::kernels::{inliers, PlaneF32};
+/// let plane = PlaneF32 { nx: 0.0, ny: 0.0, nz: 1.0, d: 0.0 };
+/// let (xs, ys, zs) = ([0.0; 4], [0.0; 4], [0.0, 0.5, -0.05, f32::NAN]);
+/// let mut out = Vec::new();
+/// inliers(&xs, &ys, &zs, plane, 0.1, 100, &mut out);
+/// assert_eq!(out, [100, 102]);
+/// ```
 pub fn inliers(
     xs: &[f32],
     ys: &[f32],
