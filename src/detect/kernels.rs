@@ -293,8 +293,8 @@ mod x86 {
         finish(&acc, &xs[body..], &ys[body..], &zs[body..], p, inv)
     }
 
-    /// [`super::inliers_scalar`] eight tests at a time (short ranges,
-    /// like one voxel's points, gain as much as long ones).
+    /// [`super::inliers_scalar`] with one AVX compare per eight points
+    /// (blocks as in [`super::list_blocks`]).
     ///
     /// # Safety
     /// The CPU must support AVX.
@@ -317,7 +317,8 @@ mod x86 {
         let sign = _mm256_set1_ps(-0.0);
         // Bit l of the mask: point `o + l` is an inlier.
         let mask8 = |o: usize| {
-            // SAFETY: callers pass o + 8 <= len of all three slices.
+            // SAFETY: each load reads a slice of exactly 8 floats (the
+            // indexing checks it; `list_blocks` keeps o + 8 <= len).
             let (x, y, z) = unsafe {
                 (
                     _mm256_loadu_ps(xs[o..o + 8].as_ptr()),
