@@ -2,6 +2,7 @@
 //! running statistics and an occupancy footprint, plus the "shaping" step
 //! that turns a support set into one (PCA refit, outline, area, solidity).
 
+use crate::geometry::plane::{robust_fit, RobustFit};
 use crate::geometry::polygon::{signed_area, simplify};
 use crate::geometry::{convex_hull, Footprint, Frame, Moments, Plane, Polygon3};
 use crate::params::{HullKind, Params, SolidityKind};
@@ -254,48 +255,18 @@ pub(crate) fn shape(
     params: &Params,
     viewpoint: DVec3,
 ) -> Option<Shaped> {
-    let first = origin + pts.first()?.as_dvec3();
-    let moments_of = |keep: &dyn Fn(usize) -> bool| {
-        let mut m = Moments::new(first.round());
-        for (i, p) in pts.iter().enumerate() {
-            if keep(i) {
-                m.push(origin + p.as_dvec3());
-            }
-        }
-        m
-    };
-    let mut moments = moments_of(&|_| true);
+    // World coordinates, once: every pass below reads them.
+    let world: Vec<DVec3> = pts.iter().map(|p| origin + p.as_dvec3()).collect();
     let tilt = params.ground_max_tilt.to_radians();
-    let (mut fit, _) = moments.fit_plane()?;
     // Robust refit: points of a crossing surface within the inlier distance
     // (the edge of a riser under a tread) tilt a plain least-squares plane.
-    // Refit on the points within 2.5 robust standard deviations
-    // (1.4826 x median absolute residual), three times. These points' moments are
-    // what the primitive keeps for later refits.
-    let mut resid: Vec<f64> = Vec::with_capacity(pts.len());
-    let mut inner = vec![true; pts.len()];
-    for _ in 0..3 {
-        resid.clear();
-        resid.extend(
-            pts.iter()
-                .map(|p| fit.signed_distance(origin + p.as_dvec3()).abs()),
-        );
-        let mut sorted = resid.clone();
-        let mid = sorted.len() / 2;
-        let (_, med, _) = sorted.select_nth_unstable_by(mid, f64::total_cmp);
-        let cut = (2.5 * 1.4826 * *med).max(1e-4);
-        let trimmed = moments_of(&|i| resid[i] <= cut);
-        match trimmed.fit_plane() {
-            Some((f, _)) if trimmed.count >= 3.0 => {
-                fit = f;
-                moments = trimmed;
-                for (k, r) in inner.iter_mut().zip(&resid) {
-                    *k = *r <= cut;
-                }
-            }
-            _ => break,
-        }
-    }
+    // The moments of the points of the last refit are what the primitive
+    // keeps for later refits.
+    let RobustFit {
+        plane: fit,
+        mut moments,
+        inner,
+    } = robust_fit(&world, world.first()?.round())?;
     let plane = fit.oriented(viewpoint);
     // Ground: near-horizontal, well below the sensor (then, oriented
     // towards the sensor, facing up).
@@ -307,14 +278,11 @@ pub(crate) fn shape(
     } else {
         params.distance
     };
-    let near: Vec<bool> = pts
+    let near: Vec<bool> = world
         .iter()
-        .map(|p| plane.signed_distance(origin + p.as_dvec3()).abs() < threshold)
+        .map(|&p| plane.signed_distance(p).abs() < threshold)
         .collect();
-    let q: Vec<DVec2> = pts
-        .iter()
-        .map(|p| frame.to_local(origin + p.as_dvec3()))
-        .collect();
+    let q: Vec<DVec2> = world.iter().map(|&p| frame.to_local(p)).collect();
     let alpha = if ground {
         params.ground_alpha
     } else {
@@ -356,9 +324,9 @@ pub(crate) fn shape(
         // cell inside it; with a convex hull every point near the plane is
         // kept, so its footprint is already right).
         let mut dropped = Moments::new(moments.reference);
-        for (i, p) in pts.iter().enumerate() {
+        for (i, &p) in world.iter().enumerate() {
             if inner[i] && !kept[i] {
-                dropped.push(origin + p.as_dvec3());
+                dropped.push(p);
             }
         }
         moments.remove(&dropped);
@@ -371,8 +339,8 @@ pub(crate) fn shape(
         return None;
     }
     let (mut sq, mut nk) = (0.0, 0usize);
-    for (p, _) in pts.iter().zip(&kept).filter(|(_, &k)| k) {
-        let d = plane.signed_distance(origin + p.as_dvec3());
+    for (&p, _) in world.iter().zip(&kept).filter(|(_, &k)| k) {
+        let d = plane.signed_distance(p);
         sq += d * d;
         nk += 1;
     }

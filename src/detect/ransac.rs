@@ -50,7 +50,8 @@
 //! `Params::max_work`.
 
 use super::kernels::{self, PlaneF32};
-use crate::geometry::{Moments, Plane};
+use crate::geometry::plane::robust_fit;
+use crate::geometry::Plane;
 use crate::hash::Buckets;
 use crate::params::Params;
 use crate::rng::Rng;
@@ -574,11 +575,9 @@ impl PlanePool {
         out
     }
 
-    /// Robust least-squares plane of the points at these pool positions:
-    /// a PCA fit, then three refits on the points within 2.5 robust standard
-    /// deviations (1.4826 x median absolute residual) of the last plane. A
-    /// tilted hypothesis that caught a road and the edge of its sidewalk
-    /// converges to the road, the majority.
+    /// Robust least-squares plane ([`robust_fit`]) of the points at these
+    /// pool positions: a tilted hypothesis that caught a road and the edge
+    /// of its sidewalk converges to the road, the majority.
     fn refit(&self, positions: &[u32]) -> Option<(DVec3, f64)> {
         let pts: Vec<DVec3> = positions
             .iter()
@@ -587,30 +586,8 @@ impl PlanePool {
                 DVec3::new(self.rx[p] as f64, self.ry[p] as f64, self.rz[p] as f64)
             })
             .collect();
-        let reference = *pts.first()?;
-        let mut m = Moments::new(reference);
-        pts.iter().for_each(|&p| m.push(p));
-        let mut plane = m.fit_plane()?.0;
-        let (mut resid, mut scratch) = (Vec::with_capacity(pts.len()), Vec::new());
-        for _ in 0..3 {
-            resid.clear();
-            resid.extend(pts.iter().map(|&p| plane.signed_distance(p).abs()));
-            scratch.clone_from(&resid);
-            let mid = scratch.len() / 2;
-            let med = *scratch.select_nth_unstable_by(mid, f64::total_cmp).1;
-            let cut = (2.5 * 1.4826 * med).max(1e-4);
-            let mut m = Moments::new(reference);
-            for (&p, &r) in pts.iter().zip(&resid) {
-                if r <= cut {
-                    m.push(p);
-                }
-            }
-            match m.fit_plane() {
-                Some((next, _)) => plane = next,
-                None => break,
-            }
-        }
-        Some((plane.normal, plane.offset))
+        let fit = robust_fit(&pts, *pts.first()?)?;
+        Some((fit.plane.normal, fit.plane.offset))
     }
 }
 

@@ -35,11 +35,6 @@ impl Plane {
         libm::acos(self.normal.dot(other.normal).abs().min(1.0))
     }
 
-    /// Is the plane within `max_tilt` radians of horizontal?
-    pub fn is_horizontal(&self, max_tilt: f64) -> bool {
-        self.normal.dot(UP).abs() >= libm::cos(max_tilt)
-    }
-
     /// Is the plane ground as seen from `viewpoint`: near-horizontal (the
     /// cosine of its tilt at least `min_cos`) with the viewpoint more than
     /// `depth` above it? Either orientation of the normal gives the same
@@ -275,6 +270,75 @@ impl Moments {
         }
         Some((Plane::from_point_normal(self.mean(), n / len), vals))
     }
+}
+
+/// A plane fitted robustly by [`robust_fit`].
+pub struct RobustFit {
+    /// The plane (normal orientation as PCA left it).
+    pub plane: Plane,
+    /// Moments of the points of the last fit.
+    pub moments: Moments,
+    /// Per point: used in the last fit?
+    pub inner: Vec<bool>,
+}
+
+/// Robust least-squares plane: a PCA fit of every point, then three refits
+/// on the points within 2.5 robust standard deviations (1.4826 x the median
+/// absolute residual, at least 0.1 mm) of the last plane, stopping early
+/// when a refit has no plane. A tilted plane that caught a surface and the
+/// edge of a crossing one (a road and its kerb, a tread and its riser)
+/// converges to the majority surface. Sums are taken relative to
+/// `reference`. `None` when the points have no plane (fewer than three,
+/// collinear). Used by RANSAC's local optimisation and by shaping.
+///
+/// ```
+/// use glam::DVec3;
+/// use polyscene::geometry::plane::robust_fit;
+/// // A floor at z = 0 and a few points of a wall rising from its edge.
+/// let mut pts: Vec<DVec3> = (0..400)
+///     .map(|i| DVec3::new((i % 20) as f64 * 0.1, (i / 20) as f64 * 0.1, 0.0))
+///     .collect();
+/// pts.extend((1..6).map(|k| DVec3::new(2.0, 1.0, k as f64 * 0.02)));
+/// let fit = robust_fit(&pts, pts[0]).unwrap();
+/// assert!(fit.plane.normal.z.abs() > 0.999_999);
+/// assert!(!fit.inner[404]);
+/// ```
+pub fn robust_fit(pts: &[DVec3], reference: DVec3) -> Option<RobustFit> {
+    let moments_of = |keep: &dyn Fn(usize) -> bool| {
+        let mut m = Moments::new(reference);
+        for (i, &p) in pts.iter().enumerate() {
+            if keep(i) {
+                m.push(p);
+            }
+        }
+        m
+    };
+    let mut moments = moments_of(&|_| true);
+    let mut plane = moments.fit_plane()?.0;
+    let mut inner = vec![true; pts.len()];
+    let (mut resid, mut sorted) = (Vec::with_capacity(pts.len()), Vec::new());
+    for _ in 0..3 {
+        resid.clear();
+        resid.extend(pts.iter().map(|&p| plane.signed_distance(p).abs()));
+        sorted.clone_from(&resid);
+        let mid = sorted.len() / 2;
+        let med = *sorted.select_nth_unstable_by(mid, f64::total_cmp).1;
+        let cut = (2.5 * 1.4826 * med).max(1e-4);
+        let trimmed = moments_of(&|i| resid[i] <= cut);
+        let Some((next, _)) = trimmed.fit_plane() else {
+            break;
+        };
+        plane = next;
+        moments = trimmed;
+        for (k, &r) in inner.iter_mut().zip(&resid) {
+            *k = r <= cut;
+        }
+    }
+    Some(RobustFit {
+        plane,
+        moments,
+        inner,
+    })
 }
 
 /// Eigen-decomposition of a symmetric 3x3 matrix by cyclic Jacobi rotations.
