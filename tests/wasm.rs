@@ -199,7 +199,9 @@ fn the_simulator_runs() {
 /// or SSE2 against the same references) and `floor_i64` (`f64.floor` here).
 #[wasm_bindgen_test]
 fn wasm_paths_match_their_references() {
-    use polyscene::detect::kernels::{inliers, inliers_scalar, msac_scalar, msac_sum, PlaneF32};
+    use polyscene::detect::kernels::{
+        inliers, inliers_scalar, msac_scalar, msac_sum, PlaneF32, Points,
+    };
     use polyscene::hash::floor_i64;
     // A pseudo-random slab of points around z = 0.5, with NaNs and -0.
     let mut s = 0x9E37_79B9_7F4A_7C15u64;
@@ -229,19 +231,16 @@ fn wasm_paths_match_their_references() {
     for len in (0..70).chain([999, 1000]) {
         for start in [0, 3] {
             let end = (start + len).min(n);
-            let (x, y, z) = (&xs[start..end], &ys[start..end], &zs[start..end]);
-            let (got, want) = (
-                msac_sum(x, y, z, plane, 10.0),
-                msac_scalar(x, y, z, plane, 10.0),
-            );
+            let pts = Points::new(&xs, &ys, &zs).slice(start..end);
+            let (got, want) = (msac_sum(pts, plane, 10.0), msac_scalar(pts, plane, 10.0));
             assert_eq!(
                 got.to_bits(),
                 want.to_bits(),
                 "msac len {len} start {start}"
             );
             let (mut got, mut want) = (Vec::new(), Vec::new());
-            inliers(x, y, z, plane, 0.1, 7, &mut got);
-            inliers_scalar(x, y, z, plane, 0.1, 7, &mut want);
+            inliers(pts, plane, 0.1, 7, &mut got);
+            inliers_scalar(pts, plane, 0.1, 7, &mut want);
             assert_eq!(got, want, "inliers len {len} start {start}");
             listed += got.len();
         }

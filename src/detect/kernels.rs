@@ -34,54 +34,95 @@ pub struct PlaneF32 {
     pub d: f32,
 }
 
+/// Points as three coordinate arrays of one length, the layout the RANSAC
+/// pool keeps them in (a removed point has x = NaN).
+#[derive(Clone, Copy, Debug)]
+pub struct Points<'a> {
+    xs: &'a [f32],
+    ys: &'a [f32],
+    zs: &'a [f32],
+}
+
+impl<'a> Points<'a> {
+    /// The points `(xs[i], ys[i], zs[i])`, as many as the shortest array.
+    pub fn new(xs: &'a [f32], ys: &'a [f32], zs: &'a [f32]) -> Self {
+        let n = xs.len().min(ys.len()).min(zs.len());
+        Points {
+            xs: &xs[..n],
+            ys: &ys[..n],
+            zs: &zs[..n],
+        }
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.xs.len()
+    }
+
+    /// No points?
+    pub fn is_empty(&self) -> bool {
+        self.xs.is_empty()
+    }
+
+    /// The points `range` of these.
+    pub fn slice(&self, range: std::ops::Range<usize>) -> Self {
+        Points {
+            xs: &self.xs[range.clone()],
+            ys: &self.ys[range.clone()],
+            zs: &self.zs[range],
+        }
+    }
+
+    /// The points from `i` on.
+    fn tail(&self, i: usize) -> Self {
+        self.slice(i..self.len())
+    }
+}
+
 /// MSAC sum over the points `(xs[i], ys[i], zs[i])`: each point with
 /// `w = 1 - ((n · p + d) * inv)^2 > 0` adds `w` (a NaN coordinate adds 0).
-/// `inv` is one over the inlier distance. The three slices must have the
-/// same length (the shortest one rules). The scoring of RANSAC hypotheses
+/// `inv` is one over the inlier distance. The scoring of RANSAC hypotheses
 /// (paper Algorithm 1, step 1), as a soft inlier count.
 ///
 /// ```
-/// use polyscene::detect::kernels::{msac_sum, PlaneF32};
+/// use polyscene::detect::kernels::{msac_sum, PlaneF32, Points};
 /// // z = 0; points at heights 0, 0.05 and 0.2, inlier distance 0.1 m.
 /// let plane = PlaneF32 { nx: 0.0, ny: 0.0, nz: 1.0, d: 0.0 };
 /// let (xs, ys, zs) = ([0.0, 1.0, 2.0], [0.0; 3], [0.0, 0.05, 0.2]);
-/// let s = msac_sum(&xs, &ys, &zs, plane, 10.0);
+/// let s = msac_sum(Points::new(&xs, &ys, &zs), plane, 10.0);
 /// assert!((s - 1.75).abs() < 1e-6); // 1 + (1 - 0.5^2) + 0
 /// ```
-pub fn msac_sum(xs: &[f32], ys: &[f32], zs: &[f32], plane: PlaneF32, inv: f32) -> f64 {
-    let n = xs.len().min(ys.len()).min(zs.len());
-    let (xs, ys, zs) = (&xs[..n], &ys[..n], &zs[..n]);
+pub fn msac_sum(pts: Points, plane: PlaneF32, inv: f32) -> f64 {
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx") {
             // SAFETY: the CPU has AVX (checked just above).
-            return unsafe { x86::msac_avx(xs, ys, zs, plane, inv) };
+            return unsafe { x86::msac_avx(pts, plane, inv) };
         }
-        x86::msac_sse2(xs, ys, zs, plane, inv)
+        x86::msac_sse2(pts, plane, inv)
     }
     #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
     {
-        wasm::msac_simd128(xs, ys, zs, plane, inv)
+        wasm::msac_simd128(pts, plane, inv)
     }
     #[cfg(not(any(
         target_arch = "x86_64",
         all(target_arch = "wasm32", target_feature = "simd128")
     )))]
     {
-        msac_scalar(xs, ys, zs, plane, inv)
+        msac_scalar(pts, plane, inv)
     }
 }
 
 /// The reference [`msac_sum`]: plain Rust, the order of operations every
 /// vector version keeps.
-pub fn msac_scalar(xs: &[f32], ys: &[f32], zs: &[f32], plane: PlaneF32, inv: f32) -> f64 {
-    let n = xs.len().min(ys.len()).min(zs.len());
-    let body = n / 8 * 8;
+pub fn msac_scalar(pts: Points, plane: PlaneF32, inv: f32) -> f64 {
+    let body = pts.len() / 8 * 8;
     let mut acc = [0f32; 8];
     for i in 0..body {
-        acc[i % 8] += msac_term(xs[i], ys[i], zs[i], plane, inv);
+        acc[i % 8] += msac_term(pts.xs[i], pts.ys[i], pts.zs[i], plane, inv);
     }
-    finish(&acc, &xs[body..n], &ys[body..n], &zs[body..n], plane, inv)
+    finish(&acc, pts.tail(body), plane, inv)
 }
 
 #[inline(always)]
@@ -97,10 +138,10 @@ fn msac_term(x: f32, y: f32, z: f32, p: PlaneF32, inv: f32) -> f32 {
 
 /// The lanes in f64, lane 0 first, then the tail point by point.
 #[inline(always)]
-fn finish(acc: &[f32; 8], tx: &[f32], ty: &[f32], tz: &[f32], p: PlaneF32, inv: f32) -> f64 {
+fn finish(acc: &[f32; 8], tail: Points, p: PlaneF32, inv: f32) -> f64 {
     let mut c: f64 = acc.iter().map(|&a| a as f64).sum();
-    for i in 0..tx.len() {
-        c += msac_term(tx[i], ty[i], tz[i], p, inv) as f64;
+    for i in 0..tail.len() {
+        c += msac_term(tail.xs[i], tail.ys[i], tail.zs[i], p, inv) as f64;
     }
     c
 }
@@ -109,51 +150,33 @@ fn finish(acc: &[f32; 8], tx: &[f32], ty: &[f32], tz: &[f32], p: PlaneF32, inv: 
 /// `|n · p + d| < t` (NaN coordinates never qualify), in increasing order.
 ///
 /// ```
-/// use polyscene::detect::kernels::{inliers, PlaneF32};
+/// use polyscene::detect::kernels::{inliers, PlaneF32, Points};
 /// let plane = PlaneF32 { nx: 0.0, ny: 0.0, nz: 1.0, d: 0.0 };
 /// let (xs, ys, zs) = ([0.0; 4], [0.0; 4], [0.0, 0.5, -0.05, f32::NAN]);
 /// let mut out = Vec::new();
-/// inliers(&xs, &ys, &zs, plane, 0.1, 100, &mut out);
+/// inliers(Points::new(&xs, &ys, &zs), plane, 0.1, 100, &mut out);
 /// assert_eq!(out, [100, 102]);
 /// ```
-pub fn inliers(
-    xs: &[f32],
-    ys: &[f32],
-    zs: &[f32],
-    plane: PlaneF32,
-    t: f32,
-    base: u32,
-    out: &mut Vec<u32>,
-) {
-    let n = xs.len().min(ys.len()).min(zs.len());
-    let (xs, ys, zs) = (&xs[..n], &ys[..n], &zs[..n]);
+pub fn inliers(pts: Points, plane: PlaneF32, t: f32, base: u32, out: &mut Vec<u32>) {
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx") {
             // SAFETY: the CPU has AVX (checked just above).
-            return unsafe { x86::inliers_avx(xs, ys, zs, plane, t, base, out) };
+            return unsafe { x86::inliers_avx(pts, plane, t, base, out) };
         }
     }
     #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
     {
-        return wasm::inliers_simd128(xs, ys, zs, plane, t, base, out);
+        return wasm::inliers_simd128(pts, plane, t, base, out);
     }
     #[allow(unreachable_code)]
-    inliers_scalar(xs, ys, zs, plane, t, base, out)
+    inliers_scalar(pts, plane, t, base, out)
 }
 
 /// The reference [`inliers`]: 64 tests into a bit mask, then the set bits
 /// (inliers are a minority, so most masks are empty).
-pub fn inliers_scalar(
-    xs: &[f32],
-    ys: &[f32],
-    zs: &[f32],
-    p: PlaneF32,
-    t: f32,
-    base: u32,
-    out: &mut Vec<u32>,
-) {
-    let n = xs.len().min(ys.len()).min(zs.len());
+pub fn inliers_scalar(pts: Points, p: PlaneF32, t: f32, base: u32, out: &mut Vec<u32>) {
+    let (n, Points { xs, ys, zs }) = (pts.len(), pts);
     let mut start = 0;
     while start < n {
         let end = n.min(start + 64);
@@ -171,24 +194,21 @@ pub fn inliers_scalar(
 /// bit-listing loop per 64 points: its exit is the branch that
 /// mispredicts), then 8-point ones, then the reference for the tail.
 /// `mask8(o)` has bit `l` set when point `o + l` is an inlier; it is only
-/// called with `o + 8 <= xs.len()`.
+/// called with `o + 8 <= pts.len()`.
 #[cfg(any(
     target_arch = "x86_64",
     all(target_arch = "wasm32", target_feature = "simd128")
 ))]
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 fn list_blocks(
-    xs: &[f32],
-    ys: &[f32],
-    zs: &[f32],
+    pts: Points,
     p: PlaneF32,
     t: f32,
     base: u32,
     out: &mut Vec<u32>,
     mask8: impl Fn(usize) -> u64,
 ) {
-    let (n, mut o) = (xs.len(), 0);
+    let (n, mut o) = (pts.len(), 0);
     while o + 64 <= n {
         let mut m = 0u64;
         for j in 0..8 {
@@ -201,7 +221,7 @@ fn list_blocks(
         push_bits(mask8(o), base + o as u32, out);
         o += 8;
     }
-    inliers_scalar(&xs[o..], &ys[o..], &zs[o..], p, t, base + o as u32, out);
+    inliers_scalar(pts.tail(o), p, t, base + o as u32, out);
 }
 
 #[inline(always)]
@@ -214,13 +234,13 @@ fn push_bits(mut m: u64, base: u32, out: &mut Vec<u32>) {
 
 #[cfg(target_arch = "x86_64")]
 mod x86 {
-    use super::{finish, PlaneF32};
+    use super::{finish, PlaneF32, Points};
     use std::arch::x86_64::*;
 
     /// [`super::msac_scalar`] with two 4-lane SSE2 accumulators (lanes
     /// 0-3 and 4-7). SSE2 is part of every x86_64 CPU.
-    pub fn msac_sse2(xs: &[f32], ys: &[f32], zs: &[f32], p: PlaneF32, inv: f32) -> f64 {
-        let body = xs.len() / 8 * 8;
+    pub fn msac_sse2(pts: Points, p: PlaneF32, inv: f32) -> f64 {
+        let (body, Points { xs, ys, zs }) = (pts.len() / 8 * 8, pts);
         let mut acc = [0f32; 8];
         // SAFETY: SSE2 is baseline on x86_64; every load reads 4 floats
         // inside a chunk of 8 of a slice (chunks_exact).
@@ -250,7 +270,7 @@ mod x86 {
             _mm_storeu_ps(acc.as_mut_ptr(), lo);
             _mm_storeu_ps(acc[4..].as_mut_ptr(), hi);
         }
-        finish(&acc, &xs[body..], &ys[body..], &zs[body..], p, inv)
+        finish(&acc, pts.tail(body), p, inv)
     }
 
     /// [`super::msac_scalar`] with one 8-lane AVX accumulator.
@@ -258,8 +278,8 @@ mod x86 {
     /// # Safety
     /// The CPU must support AVX.
     #[target_feature(enable = "avx")]
-    pub unsafe fn msac_avx(xs: &[f32], ys: &[f32], zs: &[f32], p: PlaneF32, inv: f32) -> f64 {
-        let body = xs.len() / 8 * 8;
+    pub unsafe fn msac_avx(pts: Points, p: PlaneF32, inv: f32) -> f64 {
+        let (body, Points { xs, ys, zs }) = (pts.len() / 8 * 8, pts);
         let mut acc = [0f32; 8];
         let (vx, vy, vz) = (
             _mm256_set1_ps(p.nx),
@@ -290,7 +310,7 @@ mod x86 {
         }
         // SAFETY: `acc` holds exactly 8 floats.
         unsafe { _mm256_storeu_ps(acc.as_mut_ptr(), a) };
-        finish(&acc, &xs[body..], &ys[body..], &zs[body..], p, inv)
+        finish(&acc, pts.tail(body), p, inv)
     }
 
     /// [`super::inliers_scalar`] with one AVX compare per eight points
@@ -299,15 +319,8 @@ mod x86 {
     /// # Safety
     /// The CPU must support AVX.
     #[target_feature(enable = "avx")]
-    pub unsafe fn inliers_avx(
-        xs: &[f32],
-        ys: &[f32],
-        zs: &[f32],
-        p: PlaneF32,
-        t: f32,
-        base: u32,
-        out: &mut Vec<u32>,
-    ) {
+    pub unsafe fn inliers_avx(pts: Points, p: PlaneF32, t: f32, base: u32, out: &mut Vec<u32>) {
+        let Points { xs, ys, zs } = pts;
         let (vx, vy, vz) = (
             _mm256_set1_ps(p.nx),
             _mm256_set1_ps(p.ny),
@@ -332,13 +345,13 @@ mod x86 {
             let c = _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_andnot_ps(sign, v), vt);
             _mm256_movemask_ps(c) as u32 as u64
         };
-        super::list_blocks(xs, ys, zs, p, t, base, out, mask8);
+        super::list_blocks(pts, p, t, base, out, mask8);
     }
 }
 
 #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
 mod wasm {
-    use super::{finish, PlaneF32};
+    use super::{finish, PlaneF32, Points};
     use core::arch::wasm32::*;
 
     /// The first four floats of `s` (which must hold at least four).
@@ -350,8 +363,8 @@ mod wasm {
     }
 
     /// [`super::msac_scalar`] with two 4-lane simd128 accumulators.
-    pub fn msac_simd128(xs: &[f32], ys: &[f32], zs: &[f32], p: PlaneF32, inv: f32) -> f64 {
-        let body = xs.len() / 8 * 8;
+    pub fn msac_simd128(pts: Points, p: PlaneF32, inv: f32) -> f64 {
+        let (body, Points { xs, ys, zs }) = (pts.len() / 8 * 8, pts);
         let (vx, vy, vz) = (f32x4_splat(p.nx), f32x4_splat(p.ny), f32x4_splat(p.nz));
         let (vd, vi) = (f32x4_splat(p.d), f32x4_splat(inv));
         let (one, zero) = (f32x4_splat(1.0), f32x4_splat(0.0));
@@ -381,19 +394,12 @@ mod wasm {
             f32x4_extract_lane::<2>(hi),
             f32x4_extract_lane::<3>(hi),
         ];
-        finish(&acc, &xs[body..], &ys[body..], &zs[body..], p, inv)
+        finish(&acc, pts.tail(body), p, inv)
     }
 
     /// [`super::inliers_scalar`] four tests at a time.
-    pub fn inliers_simd128(
-        xs: &[f32],
-        ys: &[f32],
-        zs: &[f32],
-        p: PlaneF32,
-        t: f32,
-        base: u32,
-        out: &mut Vec<u32>,
-    ) {
+    pub fn inliers_simd128(pts: Points, p: PlaneF32, t: f32, base: u32, out: &mut Vec<u32>) {
+        let Points { xs, ys, zs } = pts;
         let (vx, vy, vz) = (f32x4_splat(p.nx), f32x4_splat(p.ny), f32x4_splat(p.nz));
         let (vd, vt) = (f32x4_splat(p.d), f32x4_splat(t));
         // Bit l of the mask: point `o + l` is an inlier (o + 4 <= len).
@@ -404,7 +410,7 @@ mod wasm {
             i32x4_bitmask(f32x4_lt(f32x4_abs(v), vt)) as u64
         };
         let mask8 = |o: usize| mask4(o) | mask4(o + 4) << 4;
-        super::list_blocks(xs, ys, zs, p, t, base, out, mask8);
+        super::list_blocks(pts, p, t, base, out, mask8);
     }
 }
 
@@ -444,8 +450,8 @@ mod tests {
             for start in [0, 1, 5] {
                 let end = (start + len).min(xs.len());
                 let (x, y, z) = (&xs[start..end], &ys[start..end], &zs[start..end]);
-                let want = msac_scalar(x, y, z, PLANE, 10.0);
-                let got = msac_sum(x, y, z, PLANE, 10.0);
+                let want = msac_scalar(Points::new(x, y, z), PLANE, 10.0);
+                let got = msac_sum(Points::new(x, y, z), PLANE, 10.0);
                 assert_eq!(got.to_bits(), want.to_bits(), "len {len} start {start}");
                 positive += (want > 0.0) as usize;
             }
@@ -461,7 +467,7 @@ mod tests {
             d: 0.0,
         };
         assert_eq!(
-            msac_sum(&flat, &flat, &flat, edge, 10.0).to_bits(),
+            msac_sum(Points::new(&flat, &flat, &flat), edge, 10.0).to_bits(),
             0f64.to_bits()
         );
     }
@@ -473,8 +479,8 @@ mod tests {
         let (xs, ys, zs) = cloud(1000 + 5, 4);
         for len in (0..40).chain([999, 1005]) {
             let (x, y, z) = (&xs[..len], &ys[..len], &zs[..len]);
-            let want = msac_scalar(x, y, z, PLANE, 10.0);
-            let got = x86::msac_sse2(x, y, z, PLANE, 10.0);
+            let want = msac_scalar(Points::new(x, y, z), PLANE, 10.0);
+            let got = x86::msac_sse2(Points::new(x, y, z), PLANE, 10.0);
             assert_eq!(got.to_bits(), want.to_bits(), "len {len}");
         }
     }
@@ -497,10 +503,10 @@ mod tests {
             nz: 1.0,
             d: -0.5,
         };
-        let s = msac_sum(&xs, &ys, &zs, plane, 10.0);
+        let s = msac_sum(Points::new(&xs, &ys, &zs), plane, 10.0);
         assert!((s - 115.0).abs() < 1e-3, "{s}");
         let mut out = Vec::new();
-        inliers(&xs, &ys, &zs, plane, 0.1, 1000, &mut out);
+        inliers(Points::new(&xs, &ys, &zs), plane, 0.1, 1000, &mut out);
         let want: Vec<u32> = (1000..1120).collect();
         assert_eq!(out, want);
     }
@@ -513,13 +519,13 @@ mod tests {
                 let end = (start + len).min(xs.len());
                 let (x, y, z) = (&xs[start..end], &ys[start..end], &zs[start..end]);
                 let (mut want, mut got) = (vec![7], vec![7]);
-                inliers_scalar(x, y, z, PLANE, 0.1, 40, &mut want);
-                inliers(x, y, z, PLANE, 0.1, 40, &mut got);
+                inliers_scalar(Points::new(x, y, z), PLANE, 0.1, 40, &mut want);
+                inliers(Points::new(x, y, z), PLANE, 0.1, 40, &mut got);
                 assert_eq!(got, want, "len {len} start {start}");
             }
         }
         let mut all = Vec::new();
-        inliers(&xs, &ys, &zs, PLANE, 0.1, 0, &mut all);
+        inliers(Points::new(&xs, &ys, &zs), PLANE, 0.1, 0, &mut all);
         assert!(all.len() > 500 && all.len() < 2000, "{}", all.len());
     }
 }

@@ -471,6 +471,11 @@ impl PlanePool {
         Some((nrm, -nrm.dot(p1), c))
     }
 
+    /// The scoring pool's coordinates, in pool order.
+    fn pool_points(&self) -> kernels::Points<'_> {
+        kernels::Points::new(&self.rx, &self.ry, &self.rz)
+    }
+
     /// MSAC score of `plane` over pool entries `lo..hi`: each point within
     /// the threshold counts `1 - (d/t)^2`, others (and dead entries) 0. A
     /// soft inlier count: a plane through the middle of a surface scores
@@ -478,8 +483,7 @@ impl PlanePool {
     /// ([`kernels::msac_sum`]: the same bits on every target.)
     fn count(&self, plane: &LocalPlane, lo: usize, hi: usize) -> f64 {
         let inv = (1.0 / plane.threshold) as f32;
-        let (xs, ys, zs) = (&self.rx[lo..hi], &self.ry[lo..hi], &self.rz[lo..hi]);
-        kernels::msac_sum(xs, ys, zs, plane.as_f32(), inv)
+        kernels::msac_sum(self.pool_points().slice(lo..hi), plane.as_f32(), inv)
     }
 
     /// MSAC score of `plane` over the first `k` pool entries, or an
@@ -562,16 +566,8 @@ impl PlanePool {
     /// bits; inliers are a minority, so most masks are sparse or empty).
     fn inliers_in(&self, plane: &LocalPlane, k: usize) -> Vec<u32> {
         let mut out = Vec::new();
-        let (xs, ys, zs) = (&self.rx[..k], &self.ry[..k], &self.rz[..k]);
-        kernels::inliers(
-            xs,
-            ys,
-            zs,
-            plane.as_f32(),
-            plane.threshold as f32,
-            0,
-            &mut out,
-        );
+        let (pts, t) = (self.pool_points().slice(0..k), plane.threshold as f32);
+        kernels::inliers(pts, plane.as_f32(), t, 0, &mut out);
         out
     }
 
