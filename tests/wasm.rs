@@ -246,37 +246,31 @@ fn wasm_paths_match_their_references() {
         }
     }
     assert!(listed > 100, "{listed}");
-    // floor_i64 against the portable formula the native build uses.
-    let portable = |x: f64| {
-        let i = x as i64;
-        if (i as f64) > x {
-            i.saturating_sub(1)
-        } else {
-            i
-        }
-    };
-    for x in [
-        0.0,
-        -0.0,
-        0.5,
-        -0.5,
-        1.0,
-        -1.0,
-        2.999,
-        -2.999,
-        1e12 + 0.5,
-        -1e12 - 0.5,
-        7.0 / 3.0,
+    // floor_i64 (f64.floor here) against libm's floor, as the native unit
+    // test checks the native formula: quarter steps around zero and far
+    // out, either side of each integer, the i64 limits and beyond, NaN.
+    let mut probes: Vec<f64> = (-40..=40).map(|k| k as f64 * 0.25).collect();
+    for base in [1e6, 4503599627370495.0, 9.2e18] {
+        probes.extend([
+            base - 0.5,
+            base,
+            base + 0.5,
+            -base - 0.5,
+            -base,
+            -base + 0.5,
+        ]);
+    }
+    probes.extend([
         1e19,
         -1e19,
-        9.3e18,
-        -9.3e18,
         f64::INFINITY,
         f64::NEG_INFINITY,
-        f64::NAN,
-        4503599627370495.5,
-        -4503599627370495.5,
-    ] {
-        assert_eq!(floor_i64(x), portable(x), "{x}");
+        -0.0,
+        1e-300,
+        -1e-300,
+    ]);
+    for x in probes {
+        assert_eq!(floor_i64(x), libm::floor(x) as i64, "{x}");
     }
+    assert_eq!(floor_i64(f64::NAN), 0);
 }
