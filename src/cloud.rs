@@ -70,26 +70,24 @@ impl Cloud {
         if let Some(i) = points.iter().position(|p| !p.is_finite()) {
             return Err(Error::NonFinite { point: i });
         }
-        let origin = bbox_centre(points.iter().copied()).round();
-        Ok(Cloud {
-            origin,
-            points: points.iter().map(|&p| (p - origin).as_vec3()).collect(),
-        })
+        Ok(Self::around_box_centre(points.iter().copied()))
     }
 
     /// From a flat f32 buffer (stride 3 or 4), world frame.
     pub fn from_flat(values: &[f32], stride: usize) -> Result<Self> {
         check_finite(values, stride)?;
-        // What `from_world_f64` computes, without an f64 copy of the cloud.
         let at = |p: &[f32]| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
-        let origin = bbox_centre(values.chunks_exact(stride).map(at)).round();
-        Ok(Cloud {
+        Ok(Self::around_box_centre(values.chunks_exact(stride).map(at)))
+    }
+
+    /// Finite world points (read twice, never copied) around the centre of
+    /// their box rounded to whole metres.
+    fn around_box_centre(points: impl Iterator<Item = DVec3> + Clone) -> Self {
+        let origin = bbox_centre(points.clone()).round();
+        Cloud {
             origin,
-            points: values
-                .chunks_exact(stride)
-                .map(|p| (at(p) - origin).as_vec3())
-                .collect(),
-        })
+            points: points.map(|p| (p - origin).as_vec3()).collect(),
+        }
     }
 
     /// From a flat f32 buffer in a sensor frame and a world-from-sensor pose:
