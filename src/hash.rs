@@ -156,13 +156,20 @@ impl Buckets {
 /// (the dense array is cleared cell by cell, not refilled).
 #[derive(Default)]
 pub struct CellIds {
-    /// `ids[(y - lo.1) * w + (x - lo.0)]`, `u32::MAX` when empty.
+    /// `ids[(y - lo.1 + pad) * stride + (x - lo.0)]`, `u32::MAX` when empty
+    /// (as are the margin's cells).
     ids: Vec<u32>,
     map: GridMap<u64, u32>,
     dense: bool,
     lo: (i64, i64),
     w: usize,
     h: usize,
+    /// Empty rows below and above the box, and empty columns right of it:
+    /// 2 after [`CellIds::assign_points`] (see [`CellIds::dense_grid`]),
+    /// else 0.
+    pad: usize,
+    /// `w + pad`.
+    stride: usize,
     /// Cell coordinates of each id.
     pub keys: Vec<(i64, i64)>,
 }
@@ -186,11 +193,12 @@ impl CellIds {
         self.dense = !xy.is_empty() && w * h <= 4 * xy.len() as u128 + extra;
         if self.dense {
             (self.lo, self.w, self.h) = (lo, w as usize, h as usize);
+            (self.pad, self.stride) = (0, self.w);
             if self.ids.len() < self.w * self.h {
                 self.ids.resize(self.w * self.h, u32::MAX);
             }
             for &(x, y) in xy {
-                let k = (y - lo.1) as usize * self.w + (x - lo.0) as usize;
+                let k = self.index(x, y);
                 cell_of.push(self.number_dense(k, (x, y)));
             }
         } else {
@@ -209,14 +217,14 @@ impl CellIds {
     /// (keys count from 0); else cells are `floor(coordinate * inv)`. So the
     /// cell boundaries depend on the points: for callers that only need
     /// "same cell" and neighbour relations (clustering), not for fixed
-    /// patches.
+    /// patches. The dense array has the margin [`CellIds::dense_grid`]
+    /// describes.
     pub fn assign_points(
         &mut self,
         points: &[glam::DVec2],
         inv: f64,
         extra: u128,
         cell_of: &mut Vec<u32>,
-        mut seen: impl FnMut(u32, glam::DVec2),
     ) {
         self.reset();
         cell_of.clear();
@@ -224,34 +232,62 @@ impl CellIds {
             glam::DVec2::splat(f64::INFINITY),
             glam::DVec2::splat(f64::NEG_INFINITY),
         );
-        for &p in points {
+        // Four boxes over interleaved points, then merged: with one box,
+        // every point's min and max wait for the previous point's.
+        let mut part = [(lo, hi); 4];
+        let chunks = points.chunks_exact(4);
+        for &p in chunks.remainder() {
             crate::geometry::grow_box(&mut lo, &mut hi, p);
+        }
+        for four in chunks {
+            for (b, &p) in part.iter_mut().zip(four) {
+                crate::geometry::grow_box(&mut b.0, &mut b.1, p);
+            }
+        }
+        for (l, h) in part {
+            for k in 0..2 {
+                lo[k] = if l[k] < lo[k] { l[k] } else { lo[k] };
+                hi[k] = if h[k] > hi[k] { h[k] } else { hi[k] };
+            }
         }
         let (gw, gh) = (
             ((hi.x - lo.x) * inv).floor() + 1.0,
             ((hi.y - lo.y) * inv).floor() + 1.0,
         );
-        self.dense = !points.is_empty() && gw * gh <= (4 * points.len()) as f64 + extra as f64;
+        // Cell coordinates are converted through u32 below.
+        let fits = gw <= 4294967296.0 && gh <= 4294967296.0;
+        self.dense =
+            !points.is_empty() && fits && gw * gh <= (4 * points.len()) as f64 + extra as f64;
         if self.dense {
             let (w, h) = (gw as usize, gh as usize);
             (self.lo, self.w, self.h) = ((0, 0), w, h);
-            if self.ids.len() < w * h {
-                self.ids.resize(w * h, u32::MAX);
+            (self.pad, self.stride) = (2, w + 2);
+            let len = self.stride * (h + 4);
+            if self.ids.len() < len {
+                self.ids.resize(len, u32::MAX);
             }
-            for &p in points {
+            let (stride, first) = (self.stride, 2 * self.stride);
+            let (ids, keys) = (&mut self.ids[..len], &mut self.keys);
+            cell_of.extend(points.iter().map(|&p| {
                 // In range by construction; the clamps only guard rounding.
-                let x = (((p.x - lo.x) * inv) as usize).min(w - 1);
-                let y = (((p.y - lo.y) * inv) as usize).min(h - 1);
-                let id = self.number_dense(y * w + x, (x as i64, y as i64));
-                cell_of.push(id);
-                seen(id, p);
-            }
+                // Through u32 (exact: below `fits`'s bound), a cheaper
+                // conversion than to usize on x86_64.
+                let x = ((((p.x - lo.x) * inv) as u32) as usize).min(w - 1);
+                let y = ((((p.y - lo.y) * inv) as u32) as usize).min(h - 1);
+                let k = first + y * stride + x;
+                let mut id = ids[k];
+                if id == u32::MAX {
+                    id = keys.len() as u32;
+                    ids[k] = id;
+                    keys.push((x as i64, y as i64));
+                }
+                id
+            }));
         } else {
             self.map.clear();
             for &p in points {
                 let id = self.number_hashed((floor_i64(p.x * inv), floor_i64(p.y * inv)));
                 cell_of.push(id);
-                seen(id, p);
             }
         }
     }
@@ -265,11 +301,30 @@ impl CellIds {
     /// the keys.
     fn reset(&mut self) {
         if self.dense {
-            for &(x, y) in &self.keys {
-                self.ids[(y - self.lo.1) as usize * self.w + (x - self.lo.0) as usize] = u32::MAX;
+            for i in 0..self.keys.len() {
+                let (x, y) = self.keys[i];
+                let k = self.index(x, y);
+                self.ids[k] = u32::MAX;
             }
         }
         self.keys.clear();
+    }
+
+    /// Index in the dense array of the cell `(x, y)`, inside the box.
+    #[inline]
+    fn index(&self, x: i64, y: i64) -> usize {
+        (y - self.lo.1) as usize * self.stride + self.pad * self.stride + (x - self.lo.0) as usize
+    }
+
+    /// After a dense [`CellIds::assign_points`], the dense array and its
+    /// stride: the cell with key `(x, y)` is at `(y + 2) * stride + x`, and
+    /// its empty margin (two rows below and above the box, two columns
+    /// right of it) puts every cell `(x + dx, y + dy)` with `0 <= dx <= 2`,
+    /// `|dy| <= 2` in the array, at `y * stride + x + (dy + 2) * stride +
+    /// dx`, holding `u32::MAX` when outside the box: neighbours without
+    /// range tests. `None` after [`CellIds::assign`] or the hash map.
+    pub fn dense_grid(&self) -> Option<(&[u32], usize)> {
+        (self.dense && self.pad == 2).then_some((&self.ids[..], self.stride))
     }
 
     /// Id of the cell at dense index `k` with coordinates `xy`, numbered
@@ -303,7 +358,7 @@ impl CellIds {
             if dx < 0 || dy < 0 || dx as usize >= self.w || dy as usize >= self.h {
                 return None;
             }
-            let id = self.ids[dy as usize * self.w + dx as usize];
+            let id = self.ids[(dy as usize + self.pad) * self.stride + dx as usize];
             (id != u32::MAX).then_some(id)
         } else {
             self.map.get(&key2(x, y)).copied()
@@ -482,6 +537,36 @@ mod tests {
             }
         }
         assert_eq!(a, vec![0, 0, 1, 2, 0, 1]);
+    }
+
+    #[test]
+    fn dense_grid_margin_holds_every_half_neighbour() {
+        // Points over a box whose cells touch all four sides: every cell's
+        // neighbours two columns right and two rows up or down read the
+        // same id as `get`, or an empty cell, without leaving the array.
+        let mut rng = crate::rng::Rng::new(5);
+        let pts: Vec<glam::DVec2> = (0..400)
+            .map(|_| glam::DVec2::new(rng.range(-3.0, 4.0), rng.range(10.0, 12.5)))
+            .collect();
+        let (mut ids, mut cell_of) = (super::CellIds::default(), Vec::new());
+        for inv in [2.0, 0.7] {
+            ids.assign_points(&pts, inv, 1 << 10, &mut cell_of);
+            let (grid, stride) = ids.dense_grid().expect("dense");
+            for (id, &(x, y)) in ids.keys.iter().enumerate() {
+                let (xu, yu) = (x as usize, y as usize);
+                assert_eq!(grid[(yu + 2) * stride + xu], id as u32);
+                for dx in 0..=2 {
+                    for dy in -2..=2i64 {
+                        let k = yu * stride + xu + (dy + 2) as usize * stride + dx as usize;
+                        let want = ids.get(x + dx, y + dy).unwrap_or(u32::MAX);
+                        assert_eq!(grid[k], want, "{x} {y} {dx} {dy}");
+                    }
+                }
+            }
+        }
+        // The i64 keys' numbering leaves no margin.
+        ids.assign(&[(1, 1), (2, 3)], 1 << 10, &mut cell_of);
+        assert!(ids.is_dense() && ids.dense_grid().is_none());
     }
 
     #[test]
