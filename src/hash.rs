@@ -219,6 +219,7 @@ impl CellIds {
     /// "same cell" and neighbour relations (clustering), not for fixed
     /// patches. The dense array has the margin [`CellIds::dense_grid`]
     /// describes.
+    #[inline]
     pub fn assign_points(
         &mut self,
         points: &[glam::DVec2],

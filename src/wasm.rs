@@ -337,10 +337,14 @@ fn option_entries(what: &str, v: &JsValue) -> Result<Vec<(String, JsValue)>, Err
 
 /// An options object as a JSON map.
 fn options_map(what: &str, v: &JsValue) -> Result<Map<String, Value>, Error> {
-    option_entries(what, v)?
-        .into_iter()
-        .map(|(key, value)| json_value(&key, &value).map(|j| (key, j)))
-        .collect()
+    // Inserted one by one: collecting into the map would sort the entries
+    // first, with a sort instance of its own (kilobytes of wasm).
+    let mut map = Map::new();
+    for (key, value) in option_entries(what, v)? {
+        let j = json_value(&key, &value)?;
+        map.insert(key, j);
+    }
+    Ok(map)
 }
 
 /// A short description of a JS value's type, for error messages.
