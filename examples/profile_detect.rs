@@ -5,7 +5,7 @@ fn main() {
     let c = Cloud::from_flat(&v, 4).unwrap();
     let p = Params::gpp2();
     let d = detect(&c, &p).unwrap();
-    let acc = d.steps.iter().filter(|s| s.accepted).count();
+    let acc: usize = d.steps.iter().map(|s| s.accepted).sum();
     println!(
         "n={} rounds={} accepted={} work={:.1}M time={:.1}ms",
         c.len(),

@@ -149,8 +149,9 @@ pub struct Params {
     // --- Cascade budget ---
     /// Most primitives one detection returns. gpp2 default 200, gpp1 60.
     pub max_primitives: usize,
-    /// The cascade stops after this many rounds in a row found nothing
-    /// acceptable (what is left is clutter). Default 10.
+    /// The cascade stops after this many rounds in a row accepted nothing
+    /// (none of the round's plane's clusters: what is left is clutter).
+    /// Default 10.
     pub max_rejections: usize,
     /// Work budget of one detection, in point-to-plane distance evaluations
     /// (about a nanosecond each natively). Default 2e9.
@@ -176,8 +177,9 @@ pub struct Params {
     /// Longitudinal growth reach per step, other primitives (m). Default 0.6
     /// (authors 0.2).
     pub expand_along: f64,
-    /// Largest angle between two primitives' planes for a merge (deg).
-    /// Default 8.
+    /// Largest angle between two primitives' planes for a merge (deg):
+    /// the scenario's after every scan, and one-shot detection's final
+    /// pass over the pieces it found. Default 8.
     pub merge_angle: f64,
     /// Largest RMS distance of the smaller primitive's outline vertices and
     /// centroid from the larger one's plane for a merge (m); keep it below

@@ -212,6 +212,59 @@ fn coplanar_walls_with_a_gap_stay_two_polygons() {
     }
 }
 
+/// One plane often holds several surfaces: the sides of cars parked in a
+/// row. Every cluster of the round's plane is judged, so all five are found
+/// in the round that found the first; the paper's cascade (the largest
+/// cluster per round) needs a round for each.
+#[test]
+fn one_plane_holding_several_surfaces_gives_each_in_one_round() {
+    let mut rng = Rng::new(5);
+    let mut pts = Vec::new();
+    for k in 0..5 {
+        rect(
+            &mut pts,
+            DVec3::new(k as f64 * 6.0, 0.0, 0.3),
+            DVec3::X,
+            DVec3::Z,
+            4.5 - 0.2 * k as f64,
+            1.2,
+            0.05,
+            0.01,
+            &mut rng,
+        );
+    }
+    let cloud = cloud(&pts);
+    let p = Params {
+        viewpoint: [12.0, -8.0, 1.8],
+        ..Params::gpp2()
+    };
+    let det = detect(&cloud, &p).unwrap();
+    check_invariants(&cloud, &det, &p);
+    assert_eq!(det.primitives.len(), 5);
+    assert_eq!(det.steps[0].accepted, 5, "{:?}", det.steps);
+    // Largest first, each on its own car side.
+    for (k, q) in det.primitives.iter().enumerate() {
+        let side = 4.5 - 0.2 * k as f64;
+        // The outline runs through the boundary cells' centres: ~0.1 m in.
+        let true_area = side * 1.2;
+        assert!(
+            q.area > 0.75 * true_area && q.area < true_area + 0.3,
+            "{k}: area {}",
+            q.area
+        );
+        let centre = q
+            .frame
+            .to_local(DVec3::new(k as f64 * 6.0 + side / 2.0, 0.0, 0.9));
+        assert!(contains(&q.outline, centre), "{k}");
+    }
+    let paper = polyscene::detect::Detector::new(&p)
+        .largest_cluster_only()
+        .run(&cloud.points, cloud.origin, DVec3::from_array(p.viewpoint));
+    assert_eq!(paper.primitives.len(), 5);
+    assert!(paper.steps.iter().all(|s| s.accepted <= 1));
+    assert!(paper.steps.len() >= 5);
+}
+
 #[test]
 fn concave_outline_leaves_the_missing_corner_of_an_l_wall_uncovered() {
     let mut rng = Rng::new(4);
@@ -536,13 +589,17 @@ fn simulated_street_scans_and_a_location_meet_quality_floors() {
             "scan {k}: precision {}",
             m.detection.precision
         );
+        // Each surface once: the pieces one plane's clusters and a later
+        // round both outlined are merged.
+        assert_eq!(m.duplicates.count, 0, "scan {k}: duplicates");
         recall += m.detection.recall / scans.len() as f64;
         mean += m.accuracy.mean.unwrap() / scans.len() as f64;
         completeness += m.completeness.completeness / scans.len() as f64;
     }
-    assert!(recall > 0.18, "recall {recall}");
-    assert!(mean < 0.005, "mean one-sided Hausdorff {mean}");
-    assert!(completeness > 0.44, "completeness {completeness}");
+    // Measured (session 7): recall 0.276, mean 2.6 mm, completeness 0.568.
+    assert!(recall > 0.25, "recall {recall}");
+    assert!(mean < 0.004, "mean one-sided Hausdorff {mean}");
+    assert!(completeness > 0.53, "completeness {completeness}");
 
     let loc = drive.location(0, 10).unwrap();
     let cloud = Cloud::from_world_f64(&loc.points).unwrap();
@@ -574,8 +631,10 @@ fn simulated_street_scans_and_a_location_meet_quality_floors() {
         "location precision {}",
         m.detection.precision
     );
+    assert_eq!(m.duplicates.count, 0, "location duplicates");
+    // Measured (session 7): precision 0.964, completeness 0.708, 3.8 mm.
     assert!(
-        m.completeness.completeness > 0.45,
+        m.completeness.completeness > 0.65,
         "location completeness {}",
         m.completeness.completeness
     );

@@ -4,7 +4,7 @@
 mod common;
 
 use glam::{DMat4, DVec3};
-use polyscene::detect::NO_PRIMITIVE;
+use polyscene::detect::{Detector, NO_PRIMITIVE};
 use polyscene::eval::{self, EvalOptions, GtSurface};
 use polyscene::geometry::Polygon3;
 use polyscene::params::{HullKind, Params};
@@ -158,25 +158,37 @@ fn drive_through(layout: Layout) {
         .sum::<DVec3>()
         / SCANS as f64;
     let cloud = common::cloud(&pts);
-    // Two one-shot baselines on the accumulated cloud: gpp2 as it is, whose
-    // cascade stops after ten rejections in a row (on 12M points that is
-    // right after the large, well-supported surfaces), and the same cascade
-    // run to completion (no rejection stop: it ends when no plane has
-    // `minInliers` support or at its round limit), which also goes after
-    // the smaller surfaces the scenario maps.
-    let one_shot = |max_rejections: usize| {
+    // One-shot baselines on the accumulated cloud. The paper's Algorithm 1
+    // (the largest cluster of each round's plane, nothing merged), as it
+    // is (ten rejections in a row end it: on 12M points that is right after
+    // the large, well-supported surfaces) and run to completion (no
+    // rejection stop: it ends when no plane has `minInliers` support or at
+    // its round limit), which also goes after the smaller surfaces the
+    // scenario maps. And polyscene's own one-shot detection (every cluster
+    // of a round's plane judged, pieces merged), the strongest baseline.
+    let viewpoint = mean_pose;
+    let one_shot = |max_rejections: usize, paper: bool| {
         let params = Params {
-            viewpoint: mean_pose.to_array(),
+            viewpoint: viewpoint.to_array(),
             max_rejections,
             ..Params::gpp2()
         };
-        let one = polyscene::detect::detect(&cloud, &params).unwrap();
+        let one = if paper {
+            Detector::new(&params).largest_cluster_only().run(
+                &cloud.points,
+                cloud.origin,
+                viewpoint,
+            )
+        } else {
+            polyscene::detect::detect(&cloud, &params).unwrap()
+        };
         let polys: Vec<Polygon3> = one.primitives.iter().map(|p| p.polygon()).collect();
         let e = eval::evaluate(&polys, &gt, &pts, &labels, pts.len(), &opts).unwrap();
         (e, polys.len())
     };
-    let (shot, shot_n) = one_shot(Params::gpp2().max_rejections);
-    let (full, full_n) = one_shot(1_000_000);
+    let (shot, shot_n) = one_shot(Params::gpp2().max_rejections, true);
+    let (full, full_n) = one_shot(1_000_000, true);
+    let (ours, ours_n) = one_shot(Params::gpp2().max_rejections, false);
     let line = |name: &str, e: &eval::Metrics, n: usize| {
         format!(
             "{name} P {:.3} R {:.3} H {:.4} C {:.3} n {n} d {}",
@@ -188,12 +200,13 @@ fn drive_through(layout: Layout) {
         )
     };
     eprintln!(
-        "{layout:?}: {} | {} | {} | explained median {share:.3} min {least:.3}",
+        "{layout:?}: {} | {} | {} | {} | explained median {share:.3} min {least:.3}",
         line("incremental", &inc, nw),
-        line("one-shot", &shot, shot_n),
-        line("one-shot to completion", &full, full_n),
+        line("paper one-shot", &shot, shot_n),
+        line("paper one-shot to completion", &full, full_n),
+        line("polyscene one-shot", &ours, ours_n),
     );
-    // At least as good as the complete one-shot on every measure.
+    // At least as good as the paper's complete one-shot on every measure.
     assert!(
         inc.detection.precision >= full.detection.precision,
         "precision vs complete one-shot"
@@ -225,6 +238,30 @@ fn drive_through(layout: Layout) {
         "completeness"
     );
     assert!(inc.duplicates.count <= shot.duplicates.count, "duplicates");
+    // polyscene's one-shot on the whole drive (measured, session 7: street
+    // P 0.924 R 0.353 C 0.765, 3 duplicate pairs; crossing P 0.783 R 0.211
+    // C 0.701): the scenario is more precise, finds more of the scene,
+    // covers more of it, without duplicates. The one-shot's area-weighted
+    // mean error is the lower one (street 7.4 vs 8.6 mm, crossing 5.6 vs
+    // 6.0 mm; also on the surfaces both find): it fits each surface to the
+    // whole drive at once, and leaves out most of the vehicle faces. So the
+    // mean is not compared here; BENCHMARKS.md gives both.
+    assert!(
+        inc.detection.precision > ours.detection.precision,
+        "precision vs polyscene one-shot"
+    );
+    assert!(
+        inc.detection.recall > 1.5 * ours.detection.recall,
+        "recall vs polyscene one-shot"
+    );
+    assert!(
+        inc.completeness.completeness > ours.completeness.completeness,
+        "completeness vs polyscene one-shot"
+    );
+    assert!(
+        inc.duplicates.count <= ours.duplicates.count,
+        "duplicates vs polyscene one-shot"
+    );
     // Absolute floors, set from measurement (see BENCHMARKS.md): measured
     // P 0.98-0.99, R 0.40-0.55, mean 9-11 mm.
     assert!(inc.detection.precision > 0.95, "precision");

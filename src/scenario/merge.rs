@@ -19,7 +19,7 @@ pub struct MergeEvent {
 }
 
 /// Should `a` and `b` be one primitive?
-fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
+pub(crate) fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
     if a.plane.angle_to(&b.plane) > params.merge_angle.to_radians() {
         return false;
     }

@@ -7,7 +7,7 @@
 
 mod expand;
 mod index;
-mod merge;
+pub(crate) mod merge;
 
 pub use merge::MergeEvent;
 
@@ -172,8 +172,12 @@ impl Scenario {
         let rest: Vec<u32> = (0..n as u32).filter(|&i| alive[i as usize]).collect();
         report.sent_to_detection = rest.len();
         let pts: Vec<glam::Vec3> = rest.iter().map(|&i| cloud.points[i as usize]).collect();
-        let det =
-            Detector::new(p).run_with_rng(&pts, cloud.origin, sensor, Rng::derive(p.seed, scan));
+        let det = Detector::new(p).largest_cluster_only().run_with_rng(
+            &pts,
+            cloud.origin,
+            sensor,
+            Rng::derive(p.seed, scan),
+        );
         for mut prim in det.primitives {
             let local = prim.id;
             prim.id = self.next_id;
