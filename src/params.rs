@@ -90,10 +90,10 @@ pub struct Params {
     /// (a metre apart 20 m out for an HDL-64E), and a tight tolerance cuts a
     /// road into a polygon per group of rings, or drops the far rings.
     /// Default 0.5, as for other planes. 1.0 (the ground outline's radius)
-    /// is better for one-shot detection (simulated scans and locations:
-    /// higher recall and completeness, lower error, fewer rounds; see
-    /// BENCHMARKS.md) but costs the incremental scenario some sidewalk and
-    /// curb coverage.
+    /// was better for one-shot detection with the paper's cascade
+    /// (simulated scans and locations: higher recall and completeness, lower
+    /// error, fewer rounds; see BENCHMARKS.md, session 5) but costs the
+    /// incremental scenario some sidewalk and curb coverage.
     pub ground_cluster_tolerance: f64,
 
     // --- Outline ---

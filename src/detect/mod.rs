@@ -33,7 +33,8 @@ pub struct CascadeStep {
     /// Points in the largest cluster of those inliers.
     pub cluster: usize,
     /// Primitives accepted in this round (the largest cluster and, with
-    /// [`Detector::new`], the plane's other clusters).
+    /// [`Detector::new`], the plane's other clusters), before the final
+    /// merge pass.
     pub accepted: usize,
     /// Outline area of the candidate (m^2; 0 when it had no outline).
     pub area: f64,
@@ -112,12 +113,12 @@ fn seen_edge_on(s: &Shaped, viewpoint: DVec3, p: &Params) -> bool {
 /// between them).
 ///
 /// In the order found, a primitive and the newer pieces mergeable with it
-/// become one: the largest keeps its plane and frame and absorbs the
-/// others in one outline trace, provided each
-/// keeps nine tenths of its support within the inlier distance of that
-/// plane and inside the merged outline's raster region (and the primitive
-/// all of its own); the points that do not lose their label. So the
-/// detection contract (support near its plane, inside its outline) holds.
+/// become one: the largest keeps its plane and frame and absorbs the others
+/// in one outline trace, provided each keeps nine tenths of its support
+/// within the inlier distance of that plane and inside the merged outline's
+/// raster region (and the largest all of its own); the points that do not
+/// lose their label. So the detection contract (support near its plane,
+/// inside its outline) holds.
 #[inline(never)]
 fn merge_pieces(
     primitives: &mut Vec<Primitive>,
