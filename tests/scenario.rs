@@ -166,10 +166,9 @@ fn drive_through(layout: Layout) {
     // its round limit), which also goes after the smaller surfaces the
     // scenario maps. And polyscene's own one-shot detection (every cluster
     // of a round's plane judged, pieces merged), the strongest baseline.
-    let viewpoint = mean_pose;
     let one_shot = |max_rejections: usize, paper: bool| {
         let params = Params {
-            viewpoint: viewpoint.to_array(),
+            viewpoint: mean_pose.to_array(),
             max_rejections,
             ..Params::gpp2()
         };
@@ -177,7 +176,7 @@ fn drive_through(layout: Layout) {
             Detector::new(&params).largest_cluster_only().run(
                 &cloud.points,
                 cloud.origin,
-                viewpoint,
+                mean_pose,
             )
         } else {
             polyscene::detect::detect(&cloud, &params).unwrap()
