@@ -268,6 +268,9 @@ impl CellIds {
                 self.ids.resize(len, u32::MAX);
             }
             let (stride, first) = (self.stride, 2 * self.stride);
+            // `number_dense` written out over local borrows of the array and
+            // the keys: calling it measured 3 % slower over the street scan's
+            // clusterings (fields re-read per point).
             let (ids, keys) = (&mut self.ids[..len], &mut self.keys);
             cell_of.extend(points.iter().map(|&p| {
                 // In range by construction; the clamps only guard rounding.

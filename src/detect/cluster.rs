@@ -164,6 +164,17 @@ impl Clusterer {
             // (to the smaller of the two roots).
             let mut ra = if count > 0 { find(parent, c as u32) } else { 0 };
             let (a, ba) = (buckets.of(c), &self.bbox[c]);
+            // Quick look first (below): in a dense surface a few points of
+            // each cell usually already include a close pair. Four spread
+            // over the cell's points (all of them up to four), first and
+            // last included: they come mostly in scan order, so those are
+            // the cell's ends along the scan line (the first four alone
+            // sent 2.5 times as many pairs to the per-point test).
+            let spread = |of: &[u32]| {
+                let l = of.len() - 1;
+                [of[0], of[(l + 1) / 3], of[(2 * l + 1) / 3], of[l]].map(|i| points[i as usize])
+            };
+            let pa = spread(a);
             for &nb in &found[..count] {
                 let rb = find(parent, nb);
                 if ra == rb {
@@ -176,18 +187,9 @@ impl Clusterer {
                     continue;
                 }
                 let b = buckets.of(nb as usize);
-                // Quick look first: in a dense surface a few points of each
-                // cell usually already include a close pair. Four spread
-                // over the cell's points (all of them up to four), first and
-                // last included: they come mostly in scan order, so those
-                // are the cell's ends along the scan line (the first four
-                // alone sent 2.5 times as many pairs to the per-point test).
-                // All sixteen pairs at once, without a branch each.
-                let spread = |of: &[u32]| {
-                    let l = of.len() - 1;
-                    [of[0], of[(l + 1) / 3], of[(2 * l + 1) / 3], of[l]].map(|i| points[i as usize])
-                };
-                let (pa, pb) = (spread(a), spread(b));
+                // The quick look: all sixteen pairs at once, without a
+                // branch each.
+                let pb = spread(b);
                 let mut close = false;
                 for p in pa {
                     for q in pb {

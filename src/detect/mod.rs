@@ -165,8 +165,12 @@ fn merge_pieces(
         // The pieces' points, with whether they lie on `big`'s plane.
         let mut taken: Vec<(usize, bool)> = Vec::new();
         let (mut total, mut bad) = (vec![0usize; n], vec![0usize; n]);
+        let mut in_group = vec![false; n];
+        for &j in &group {
+            in_group[j] = true;
+        }
         for (i, &l) in labels.iter().enumerate() {
-            if l != NO_PRIMITIVE && group.contains(&(l as usize)) {
+            if l != NO_PRIMITIVE && in_group[l as usize] {
                 let on = out.plane.signed_distance(world(i)).abs() < threshold;
                 total[l as usize] += 1;
                 bad[l as usize] += !on as usize;
@@ -185,12 +189,12 @@ fn merge_pieces(
         else {
             continue;
         };
-        let own = &primitives[big];
-        let keeps_own = own
+        // (`out` is `big` with the pieces' cells added: same frame.)
+        let keeps_own = primitives[big]
             .footprint
             .cell_centres()
             .iter()
-            .all(|&c| region.contains(out.frame.to_local(own.frame.to_world(c))));
+            .all(|&c| region.contains(c));
         let mut kept = Vec::with_capacity(taken.len());
         for &(i, on) in &taken {
             let stay = on && region.contains(out.frame.to_local(world(i)));
