@@ -102,6 +102,24 @@ fn seen_edge_on(s: &Shaped, viewpoint: DVec3, p: &Params) -> bool {
     !contains(&prim.outline, foot) && distance(&prim.outline, foot) > 1.0
 }
 
+/// Pull the points farther than `range` from `foot` towards it, a point at
+/// distance `r` to `2 range - range^2 / r` (continuous and increasing, so
+/// nothing crosses): clustering the pulled points with a fixed tolerance `t`
+/// connects, at distance `r`, points `t (r / range)^2` apart along the line
+/// from `foot` and about `t r / (2 range)` across it. On the ground, the gap
+/// between neighbouring laser rings grows with the square of the range and
+/// the spacing along a ring linearly.
+fn pull_towards(flat: &mut [DVec2], foot: DVec2, range: f64) {
+    for q in flat {
+        let d = *q - foot;
+        // std sqrt: one instruction in wasm, the same bits everywhere.
+        let r = d.length_squared().sqrt();
+        if r > range {
+            *q = foot + d * ((2.0 - range / r) * range / r);
+        }
+    }
+}
+
 /// Merge primitives that are pieces of one surface (the scenario's rule:
 /// near-coplanar, outlines touching or overlapping), then number the
 /// survivors 0, 1, ... again, labels included. A round's plane can cut a
@@ -259,8 +277,10 @@ pub struct Detector<'p> {
 
 impl<'p> Detector<'p> {
     /// A detector with these parameters. Each round judges every cluster
-    /// of the round's plane with `min_inliers` points, and a final pass
-    /// merges pieces of one surface (see [`Detector::largest_cluster_only`]).
+    /// of the round's plane with `min_inliers` points, the ground's
+    /// clustering tolerance grows beyond `ground_cluster_range`, and a final
+    /// pass merges pieces of one surface (see
+    /// [`Detector::largest_cluster_only`]).
     pub fn new(params: &'p Params) -> Self {
         Detector {
             params,
@@ -269,7 +289,8 @@ impl<'p> Detector<'p> {
     }
 
     /// The paper's cascade: each round keeps only the largest cluster of
-    /// its plane, and nothing is merged. The scenario detects this way on
+    /// its plane (clustered with fixed tolerances), and nothing is merged.
+    /// The scenario detects this way on
     /// the points its primitives did not explain (about a tenth of a scan,
     /// mostly clutter; judging the other clusters there too measured less
     /// precise and less accurate, see BENCHMARKS.md) and merges with its own
@@ -322,12 +343,18 @@ impl<'p> Detector<'p> {
                 offset: plane.offset,
             };
             let frame = Frame::on_plane(&local, coords[0].as_dvec3());
-            let flat: Vec<DVec2> = coords
+            let mut flat: Vec<DVec2> = coords
                 .iter()
                 .map(|p| frame.to_local(p.as_dvec3()))
                 .collect();
-            // The ground, seen at grazing angles, has its own tolerance.
+            // The ground, seen at grazing angles, has its own tolerance;
+            // beyond the paper's cascade, one growing with range beyond
+            // `ground_cluster_range`.
             let tol = if plane.ground {
+                if self.whole_planes {
+                    let foot = frame.to_local(viewpoint - origin);
+                    pull_towards(&mut flat, foot, p.ground_cluster_range);
+                }
                 p.ground_cluster_tolerance
             } else {
                 p.cluster_tolerance
