@@ -35,6 +35,9 @@ const REP_SIM = Number(opt("repeat-sim", 3));
 const REP_REAL = Number(opt("repeat-real", 5));
 const PCL_REP_SIM = Number(opt("pcljs-repeat-sim", 1));
 const PCL_REP_REAL = Number(opt("pcljs-repeat-real", 3));
+// gpp2 on the real scans once more per RANSAC seed 1..SEEDS: how long the
+// cascade runs depends on the seed.
+const SEEDS = Number(opt("seeds", 12));
 const PLANES = 15;
 const only = opt("clouds", null)?.split(",");
 fs.mkdirSync(outDir, { recursive: true });
@@ -187,6 +190,18 @@ function pclLoop(f) {
       }
     }
     const entry = { cloud: c.name, points: f.length / 4 };
+    if (ps && !sim && SEEDS > 0) {
+      const timesMs = [];
+      const polygons = [];
+      for (let seed = 1; seed <= SEEDS; seed++) {
+        const t = performance.now();
+        const n = ps.detect(f, { preset: "gpp2", stride: 4, viewpoint: c.viewpoint, seed }).length;
+        timesMs.push(performance.now() - t);
+        polygons.push(n);
+      }
+      entry.wasm_gpp2_seeds = { seeds: SEEDS, timesMs, medianMs: median(timesMs), polygons };
+      log(`  wasm   ${c.name.padEnd(8)} gpp2 seeds 1-${SEEDS}: median ${median(timesMs).toFixed(1)} ms (${Math.min(...timesMs).toFixed(1)}-${Math.max(...timesMs).toFixed(1)})`);
+    }
     if (ps) {
       for (const preset of ["gpp1", "gpp2"]) {
         const polygons = last[preset].map((p) => {
