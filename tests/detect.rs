@@ -720,6 +720,44 @@ fn planes_through_the_viewpoint_away_from_it_are_not_surfaces() {
     assert_eq!(flat_at(&detect(&c, &on_floor).unwrap(), 0.0), 1);
 }
 
+/// Points on flat ground (z = 0 +- 1 cm) along circles of these radii
+/// around the origin, 0.1 m apart along each, each radius off by up to
+/// `jitter`: the laser rings of a sensor 1.8 m above the origin.
+fn ground_rings(radii: &[f64], jitter: f64, rng: &mut Rng) -> Vec<DVec3> {
+    let mut pts = Vec::new();
+    for &r in radii {
+        let steps = (std::f64::consts::TAU * r / 0.1) as usize;
+        for s in 0..steps {
+            let a = std::f64::consts::TAU * s as f64 / steps as f64;
+            let rr = r + rng.range(-jitter, jitter);
+            pts.push(DVec3::new(
+                rr * libm::cos(a),
+                rr * libm::sin(a),
+                rng.range(-0.01, 0.01),
+            ));
+        }
+    }
+    pts
+}
+
+/// The largest ground polygon's area (m^2) gpp2 with these changes finds
+/// in `cloud` seen from 1.8 m above the origin, the detection's invariants
+/// checked.
+fn largest_ground_area(cloud: &Cloud, change: impl Fn(&mut Params)) -> f64 {
+    let mut p = Params {
+        viewpoint: [0.0, 0.0, 1.8],
+        ..Params::gpp2()
+    };
+    change(&mut p);
+    let det = detect(cloud, &p).unwrap();
+    check_invariants(cloud, &det, &p);
+    det.primitives
+        .iter()
+        .filter(|q| q.ground)
+        .map(|q| q.area)
+        .fold(0.0, f64::max)
+}
+
 /// Laser rings on flat ground: 0.15 m apart near the sensor, 0.8 m apart
 /// beyond 12 m (as an HDL-64E's lower rings are 15-20 m out). With the
 /// ground's clustering tolerance above the far spacing all rings are one
@@ -728,38 +766,12 @@ fn planes_through_the_viewpoint_away_from_it_are_not_surfaces() {
 #[test]
 fn ground_rings_join_under_the_ground_clustering_tolerance() {
     let mut rng = Rng::new(11);
-    let mut pts = Vec::new();
     let radii: Vec<f64> = (0..60)
         .map(|k| 3.0 + 0.15 * k as f64)
         .chain((0..8).map(|k| 12.8 + 0.8 * k as f64))
         .collect();
-    for &r in &radii {
-        let steps = (std::f64::consts::TAU * r / 0.1) as usize;
-        for s in 0..steps {
-            let a = std::f64::consts::TAU * s as f64 / steps as f64;
-            let rr = r + rng.range(-0.03, 0.03);
-            pts.push(DVec3::new(
-                rr * libm::cos(a),
-                rr * libm::sin(a),
-                rng.range(-0.01, 0.01),
-            ));
-        }
-    }
-    let cloud = cloud(&pts);
-    let ground_area = |tol: f64| {
-        let p = Params {
-            viewpoint: [0.0, 0.0, 1.8],
-            ground_cluster_tolerance: tol,
-            ..Params::gpp2()
-        };
-        let det = detect(&cloud, &p).unwrap();
-        check_invariants(&cloud, &det, &p);
-        det.primitives
-            .iter()
-            .filter(|q| q.ground)
-            .map(|q| q.area)
-            .fold(0.0, f64::max)
-    };
+    let cloud = cloud(&ground_rings(&radii, 0.03, &mut rng));
+    let ground_area = |tol: f64| largest_ground_area(&cloud, |p| p.ground_cluster_tolerance = tol);
     let annulus = std::f64::consts::PI * (18.4f64.powi(2) - 3.0f64.powi(2));
     let near = std::f64::consts::PI * (11.85f64.powi(2) - 3.0f64.powi(2));
     let joined = ground_area(1.0);
@@ -784,41 +796,20 @@ fn ground_rings_join_under_the_ground_clustering_tolerance() {
 #[test]
 fn far_ground_rings_join_beyond_the_ground_clustering_range() {
     let mut rng = Rng::new(12);
-    let mut pts = Vec::new();
-    let (mut r, mut outer) = (3.0, 3.0);
-    while r < 30.0 {
-        outer = r;
-        let steps = (std::f64::consts::TAU * r / 0.1) as usize;
-        for s in 0..steps {
-            let a = std::f64::consts::TAU * s as f64 / steps as f64;
-            let rr = r + rng.range(-0.02, 0.02);
-            pts.push(DVec3::new(
-                rr * libm::cos(a),
-                rr * libm::sin(a),
-                rng.range(-0.01, 0.01),
-            ));
-        }
-        r += if r < 20.0 {
-            0.15
-        } else {
-            0.45 * (r / 20.0).powi(2)
-        };
+    let mut radii = vec![3.0f64];
+    while let Some(&r) = radii.last().filter(|&&r| r < 30.0) {
+        radii.push(
+            r + if r < 20.0 {
+                0.15
+            } else {
+                0.45 * (r / 20.0).powi(2)
+            },
+        );
     }
-    let cloud = cloud(&pts);
-    let ground_area = |range: f64| {
-        let p = Params {
-            viewpoint: [0.0, 0.0, 1.8],
-            ground_cluster_range: range,
-            ..Params::gpp2()
-        };
-        let det = detect(&cloud, &p).unwrap();
-        check_invariants(&cloud, &det, &p);
-        det.primitives
-            .iter()
-            .filter(|q| q.ground)
-            .map(|q| q.area)
-            .fold(0.0, f64::max)
-    };
+    radii.pop();
+    let outer = *radii.last().unwrap();
+    let cloud = cloud(&ground_rings(&radii, 0.02, &mut rng));
+    let ground_area = |range: f64| largest_ground_area(&cloud, |p| p.ground_cluster_range = range);
     let disc = std::f64::consts::PI * (outer * outer - 9.0);
     let joined = ground_area(Params::gpp2().ground_cluster_range);
     assert!(
