@@ -180,8 +180,9 @@ fn merge_pieces(
         } else {
             p.distance
         };
-        // The pieces' points, with whether they lie on `big`'s plane.
-        let mut taken: Vec<(usize, bool)> = Vec::new();
+        // The pieces' points, with their coordinates in `big`'s frame when
+        // they lie on its plane.
+        let mut taken: Vec<(usize, Option<DVec2>)> = Vec::new();
         let (mut total, mut bad) = (vec![0usize; n], vec![0usize; n]);
         let mut in_group = vec![false; n];
         for &j in &group {
@@ -189,17 +190,14 @@ fn merge_pieces(
         }
         for (i, &l) in labels.iter().enumerate() {
             if l != NO_PRIMITIVE && in_group[l as usize] {
-                let on = out.plane.signed_distance(world(i)).abs() < threshold;
+                let w = world(i);
+                let on = out.plane.signed_distance(w).abs() < threshold;
                 total[l as usize] += 1;
                 bad[l as usize] += !on as usize;
-                taken.push((i, on));
+                taken.push((i, on.then(|| out.frame.to_local(w))));
             }
         }
-        let marks: Vec<DVec2> = taken
-            .iter()
-            .filter(|t| t.1)
-            .map(|t| out.frame.to_local(world(t.0)))
-            .collect();
+        let marks: Vec<DVec2> = taken.iter().filter_map(|t| t.1).collect();
         out.footprint.mark_all(&marks);
         let Some((ring, region)) =
             out.footprint
@@ -214,9 +212,9 @@ fn merge_pieces(
             .iter()
             .all(|&c| region.contains(c));
         let mut kept = Vec::with_capacity(taken.len());
-        for &(i, on) in &taken {
-            let stay = on && region.contains(out.frame.to_local(world(i)));
-            bad[labels[i] as usize] += (on && !stay) as usize;
+        for &(i, q) in &taken {
+            let stay = q.is_some_and(|q| region.contains(q));
+            bad[labels[i] as usize] += (q.is_some() && !stay) as usize;
             kept.push(stay);
         }
         if !keeps_own || group.iter().any(|&j| 10 * bad[j] > total[j]) {
