@@ -151,94 +151,107 @@ fn merge_pieces(
     }
     let world = |i: usize| origin + pts[i].as_dvec3();
     let mut into: Vec<u32> = (0..n as u32).collect();
-    // In the order found; of a primitive and the newer pieces mergeable
-    // with it, the largest keeps its plane and frame.
-    for first in 0..n {
-        if into[first] != first as u32 {
-            continue;
-        }
-        let mut group: Vec<usize> = (first + 1..n)
-            .filter(|&j| {
-                into[j] == j as u32
-                    && crate::scenario::merge::mergeable(&primitives[first], &primitives[j], p)
-            })
-            .collect();
-        if group.is_empty() {
-            continue;
-        }
-        group.push(first);
-        let mut big = first;
-        for &j in &group {
-            if primitives[j].area > primitives[big].area {
-                big = j;
+    // Passes until nothing merges: a merged outline is larger and can
+    // touch a piece it did not touch before. After the first pass only
+    // groups with a primitive grown in the last one are looked at.
+    let mut grown = vec![true; n];
+    for _ in 0..n {
+        let mut next = vec![false; n];
+        // In the order found; of a primitive and the newer pieces mergeable
+        // with it, the largest keeps its plane and frame.
+        for first in 0..n {
+            if into[first] != first as u32 {
+                continue;
             }
-        }
-        group.retain(|&j| j != big);
-        let mut out = primitives[big].clone();
-        let threshold = if out.ground {
-            p.ground_distance
-        } else {
-            p.distance
-        };
-        // The pieces' points, with their coordinates in `big`'s frame when
-        // they lie on its plane.
-        let mut taken: Vec<(usize, Option<DVec2>)> = Vec::new();
-        let (mut total, mut bad) = (vec![0usize; n], vec![0usize; n]);
-        let mut in_group = vec![false; n];
-        for &j in &group {
-            in_group[j] = true;
-        }
-        for (i, &l) in labels.iter().enumerate() {
-            if l != NO_PRIMITIVE && in_group[l as usize] {
-                let w = world(i);
-                let on = out.plane.signed_distance(w).abs() < threshold;
-                total[l as usize] += 1;
-                bad[l as usize] += !on as usize;
-                taken.push((i, on.then(|| out.frame.to_local(w))));
+            let mut group: Vec<usize> = (first + 1..n)
+                .filter(|&j| {
+                    into[j] == j as u32
+                        && (grown[first] || grown[j])
+                        && crate::scenario::merge::mergeable(&primitives[first], &primitives[j], p)
+                })
+                .collect();
+            if group.is_empty() {
+                continue;
             }
-        }
-        let marks: Vec<DVec2> = taken.iter().filter_map(|t| t.1).collect();
-        out.footprint.mark_all(&marks);
-        let Some((ring, region)) =
-            out.footprint
-                .outline_region(out.alpha(p), p.simplify, p.max_vertices)
-        else {
-            continue;
-        };
-        // (`out` is `big` with the pieces' cells added: same frame.)
-        let keeps_own = primitives[big]
-            .footprint
-            .cell_centres()
-            .iter()
-            .all(|&c| region.contains(c));
-        let mut kept = Vec::with_capacity(taken.len());
-        for &(i, q) in &taken {
-            let stay = q.is_some_and(|q| region.contains(q));
-            bad[labels[i] as usize] += (q.is_some() && !stay) as usize;
-            kept.push(stay);
-        }
-        if !keeps_own || group.iter().any(|&j| 10 * bad[j] > total[j]) {
-            continue;
-        }
-        out.area = signed_area(&ring);
-        out.outline = ring;
-        out.footprint.retain_region(&region);
-        let mut gone = Moments::new(out.moments.reference);
-        for (&(i, _), &stay) in taken.iter().zip(&kept) {
-            if stay {
-                labels[i] = big as u32;
-                out.support += 1;
+            group.push(first);
+            let mut big = first;
+            for &j in &group {
+                if primitives[j].area > primitives[big].area {
+                    big = j;
+                }
+            }
+            group.retain(|&j| j != big);
+            let mut out = primitives[big].clone();
+            let threshold = if out.ground {
+                p.ground_distance
             } else {
-                labels[i] = NO_PRIMITIVE;
-                gone.push(world(i));
+                p.distance
+            };
+            // The pieces' points, with their coordinates in `big`'s frame when
+            // they lie on its plane.
+            let mut taken: Vec<(usize, Option<DVec2>)> = Vec::new();
+            let (mut total, mut bad) = (vec![0usize; n], vec![0usize; n]);
+            let mut in_group = vec![false; n];
+            for &j in &group {
+                in_group[j] = true;
             }
+            for (i, &l) in labels.iter().enumerate() {
+                if l != NO_PRIMITIVE && in_group[l as usize] {
+                    let w = world(i);
+                    let on = out.plane.signed_distance(w).abs() < threshold;
+                    total[l as usize] += 1;
+                    bad[l as usize] += !on as usize;
+                    taken.push((i, on.then(|| out.frame.to_local(w))));
+                }
+            }
+            let marks: Vec<DVec2> = taken.iter().filter_map(|t| t.1).collect();
+            out.footprint.mark_all(&marks);
+            let Some((ring, region)) =
+                out.footprint
+                    .outline_region(out.alpha(p), p.simplify, p.max_vertices)
+            else {
+                continue;
+            };
+            // (`out` is `big` with the pieces' cells added: same frame.)
+            let keeps_own = primitives[big]
+                .footprint
+                .cell_centres()
+                .iter()
+                .all(|&c| region.contains(c));
+            let mut kept = Vec::with_capacity(taken.len());
+            for &(i, q) in &taken {
+                let stay = q.is_some_and(|q| region.contains(q));
+                bad[labels[i] as usize] += (q.is_some() && !stay) as usize;
+                kept.push(stay);
+            }
+            if !keeps_own || group.iter().any(|&j| 10 * bad[j] > total[j]) {
+                continue;
+            }
+            out.area = signed_area(&ring);
+            out.outline = ring;
+            out.footprint.retain_region(&region);
+            let mut gone = Moments::new(out.moments.reference);
+            for (&(i, _), &stay) in taken.iter().zip(&kept) {
+                if stay {
+                    labels[i] = big as u32;
+                    out.support += 1;
+                } else {
+                    labels[i] = NO_PRIMITIVE;
+                    gone.push(world(i));
+                }
+            }
+            for &j in &group {
+                out.moments.merge(&primitives[j].moments);
+                into[j] = big as u32;
+            }
+            out.moments.remove(&gone);
+            primitives[big] = out;
+            next[big] = true;
         }
-        for &j in &group {
-            out.moments.merge(&primitives[j].moments);
-            into[j] = big as u32;
+        if !next.contains(&true) {
+            break;
         }
-        out.moments.remove(&gone);
-        primitives[big] = out;
+        grown = next;
     }
     // Survivors in their order, numbered densely; labels follow.
     let mut dense = vec![NO_PRIMITIVE; n];
@@ -512,12 +525,12 @@ mod tests {
         out
     }
 
-    /// Two primitives shaped from two patches, labelled as detection would.
-    fn two(a: &[Vec3], b: &[Vec3], p: &Params) -> (Vec<Primitive>, Vec<u32>, Vec<Vec3>) {
+    /// Primitives shaped from patches, labelled as detection would.
+    fn pieces(patches: &[&[Vec3]], p: &Params) -> (Vec<Primitive>, Vec<u32>, Vec<Vec3>) {
         let view = DVec3::new(2.0, -6.0, 1.5);
         let mut prims = Vec::new();
         let mut labels = Vec::new();
-        for (id, pts) in [a, b].into_iter().enumerate() {
+        for (id, pts) in patches.iter().enumerate() {
             let s = shape(DVec3::ZERO, pts, p, view).unwrap();
             assert!(s.kept.iter().all(|&k| k));
             let mut prim = s.primitive;
@@ -525,7 +538,12 @@ mod tests {
             prims.push(prim);
             labels.extend(std::iter::repeat_n(id as u32, pts.len()));
         }
-        (prims, labels, [a, b].concat())
+        (prims, labels, patches.concat())
+    }
+
+    /// Two primitives shaped from two patches.
+    fn two(a: &[Vec3], b: &[Vec3], p: &Params) -> (Vec<Primitive>, Vec<u32>, Vec<Vec3>) {
+        pieces(&[a, b], p)
     }
 
     #[test]
@@ -547,6 +565,30 @@ mod tests {
             let out = distance(&q.outline, q.frame.to_local(w));
             assert!(out <= q.footprint.cell() + p.simplify + 1e-9);
         }
+    }
+
+    /// The first and the third piece lie 3 m apart; the second overlaps
+    /// the first and touches the third. Once the first has absorbed the
+    /// second, its outline touches the third: one primitive in the end.
+    #[test]
+    fn a_merged_outline_takes_in_the_pieces_it_touches_once_grown() {
+        let p = Params::gpp2();
+        let a = patch(0.0, 4.0, 0.0, 0.0);
+        let b = patch(3.0, 7.0, 0.0, 0.025);
+        let c = patch(7.0, 10.0, 0.0, 0.0125);
+        let (mut prims, mut labels, pts) = pieces(&[&a, &b, &c], &p);
+        assert!(!crate::scenario::merge::mergeable(&prims[0], &prims[2], &p));
+        assert!(crate::scenario::merge::mergeable(&prims[1], &prims[2], &p));
+        merge_pieces(&mut prims, &mut labels, &pts, DVec3::ZERO, &p);
+        assert_eq!(prims.len(), 1);
+        assert!(labels.iter().all(|&l| l == 0));
+        assert_eq!(prims[0].support, pts.len() as u64);
+        // 10 m x 2 m, outlined through the boundary cells' centres.
+        assert!(
+            prims[0].area > 18.0 && prims[0].area < 20.1,
+            "area {}",
+            prims[0].area
+        );
     }
 
     #[test]
