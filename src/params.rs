@@ -61,8 +61,10 @@ pub struct Params {
     /// Sensor position for one-shot detection (world, m): normals of
     /// non-horizontal planes point towards it, it decides what is ground,
     /// and a plane through it (seen edge-on: laser rings) is dropped unless
-    /// it reaches within 1 m of it. Default `[0, 0, 0]`: a scan in its own
-    /// sensor frame. The scenario uses each scan's pose instead.
+    /// it reaches within 1 m of it; one-shot detection does not even try
+    /// such a plane unless 10 of its points lie within 1.5 m of the
+    /// viewpoint. Default `[0, 0, 0]`: a scan in its own sensor frame. The
+    /// scenario uses each scan's pose instead.
     pub viewpoint: [f64; 3],
     /// Fewest inliers a plane needs, and fewest support points a primitive
     /// needs; the cascade stops when the best plane has fewer. gpp2 default

@@ -598,10 +598,12 @@ fn simulated_street_scans_and_a_location_meet_quality_floors() {
     }
     // Measured (session 7): recall 0.276, mean 2.6 mm, completeness 0.568;
     // (session 8, the ground's tolerance growing beyond 20 m): 0.268,
-    // 2.6 mm, 0.567.
-    assert!(recall > 0.25, "recall {recall}");
+    // 2.6 mm, 0.567; (session 9, planes seen edge-on no hypotheses, so
+    // the facades keep their bands at the sensor's height): 0.316, 2.5 mm,
+    // 0.603.
+    assert!(recall > 0.29, "recall {recall}");
     assert!(mean < 0.004, "mean one-sided Hausdorff {mean}");
-    assert!(completeness > 0.53, "completeness {completeness}");
+    assert!(completeness > 0.57, "completeness {completeness}");
 
     let loc = drive.location(0, 10).unwrap();
     let cloud = Cloud::from_world_f64(&loc.points).unwrap();
@@ -636,9 +638,10 @@ fn simulated_street_scans_and_a_location_meet_quality_floors() {
     assert_eq!(m.duplicates.count, 0, "location duplicates");
     // Measured (session 7): precision 0.964, completeness 0.708, 3.8 mm;
     // (session 8) 0.983, 0.784, 3.0 mm: the ground's growing clustering
-    // tolerance maps the road's far rings (0.708 without it).
+    // tolerance maps the road's far rings (0.708 without it); (session 9)
+    // 0.962, 0.792, 2.8 mm.
     assert!(
-        m.completeness.completeness > 0.74,
+        m.completeness.completeness > 0.77,
         "location completeness {}",
         m.completeness.completeness
     );
@@ -718,6 +721,99 @@ fn planes_through_the_viewpoint_away_from_it_are_not_surfaces() {
         ..Params::gpp2()
     };
     assert_eq!(flat_at(&detect(&c, &on_floor).unwrap(), 0.0), 1);
+}
+
+/// The beam at the sensor's own elevation draws a horizontal ring across
+/// everything around (here vegetation 12 m away, 30,000 points) and a band
+/// across every wall. That plane is seen edge-on: as a candidate it would
+/// be rejected, and the wall's band would leave play with it. It is no
+/// hypothesis at all, so the wall keeps its band and is outlined whole.
+#[test]
+fn the_ring_at_sensor_height_leaves_the_walls_their_band() {
+    let mut rng = Rng::new(5);
+    let mut pts = Vec::new();
+    let (x, y, z) = (DVec3::X, DVec3::Y, DVec3::Z);
+    rect(
+        &mut pts,
+        DVec3::new(-15.0, -15.0, 0.0),
+        x,
+        y,
+        30.0,
+        30.0,
+        0.1,
+        0.005,
+        &mut rng,
+    );
+    let wall = pts.len()..{
+        // 8 m x 4 m, 8 m in front of the sensor.
+        rect(
+            &mut pts,
+            DVec3::new(-4.0, 8.0, 0.0),
+            x,
+            z,
+            8.0,
+            4.0,
+            0.05,
+            0.005,
+            &mut rng,
+        );
+        pts.len()
+    };
+    for k in 0..30_000 {
+        let a = std::f64::consts::TAU * k as f64 / 30_000.0;
+        let r = 12.0 + (rng.uniform() - 0.5) * 0.6;
+        pts.push(DVec3::new(
+            r * a.cos(),
+            r * a.sin(),
+            1.8 + 0.01 * rng.gaussian(),
+        ));
+    }
+    let c = cloud(&pts);
+    let p = Params {
+        viewpoint: [0.0, 0.0, 1.8],
+        ..Params::gpp2()
+    };
+    let det = detect(&c, &p).unwrap();
+    check_invariants(&c, &det, &p);
+    // The wall's primitive: the label most of its points carry (those
+    // above the ground's slab).
+    let wall: Vec<usize> = wall.filter(|&i| pts[i].z > 0.1).collect();
+    let mut votes = vec![0usize; det.primitives.len()];
+    for &i in &wall {
+        if let Some(v) = votes.get_mut(det.labels[i] as usize) {
+            *v += 1;
+        }
+    }
+    let id = (0..votes.len()).max_by_key(|&k| votes[k]).unwrap();
+    let q = &det.primitives[id];
+    assert!(q.plane.normal.y.abs() > 0.999, "{:?}", q.plane);
+    assert!(
+        votes[id] as f64 > 0.98 * wall.len() as f64,
+        "{} of {}",
+        votes[id],
+        wall.len()
+    );
+    let band: Vec<usize> = wall
+        .into_iter()
+        .filter(|&i| (pts[i].z - 1.8).abs() < 0.08)
+        .collect();
+    let kept = band
+        .iter()
+        .filter(|&&i| det.labels[i] as usize == id)
+        .count();
+    assert!(
+        kept as f64 > 0.98 * band.len() as f64,
+        "band: {kept} of {}",
+        band.len()
+    );
+    // 32 m^2, outlined through the boundary cells' centres.
+    assert!(q.area > 29.0 && q.area < 32.1, "wall area {}", q.area);
+    // And nothing horizontal at the sensor's height.
+    assert!(!det
+        .primitives
+        .iter()
+        .any(|q| q.plane.normal.z.abs() > 0.99
+            && (q.plane.offset * q.plane.normal.z + 1.8).abs() < 0.2));
 }
 
 /// Points on flat ground (z = 0 +- 1 cm) along circles of these radii

@@ -328,7 +328,12 @@ impl<'p> Detector<'p> {
     ) -> Detection {
         let p = self.params;
         let t0 = clock::now_ms();
-        let mut pool = PlanePool::new(pts, p.sample_radius, rng);
+        let mut pool = PlanePool::new(
+            pts,
+            p.sample_radius,
+            self.whole_planes.then_some(viewpoint - origin),
+            rng,
+        );
         let mut labels = vec![NO_PRIMITIVE; pts.len()];
         let mut primitives: Vec<Primitive> = Vec::new();
         let mut steps = Vec::new();

@@ -120,9 +120,20 @@ pub struct PlanePool {
     pool_live: usize,
     /// Pool position of each position (`u32::MAX` when not in the pool).
     pos_of: Vec<u32>,
+    /// Positions of the points within [`NEAR_VIEWPOINT`] of the viewpoint,
+    /// when planes seen edge-on are no hypotheses (see
+    /// [`PlanePool::seen_edge_on`]).
+    near: Option<Vec<u32>>,
     /// Point-to-plane distance evaluations so far.
     pub work: u64,
 }
+
+/// Radius (m) around the viewpoint within which points tell whether the
+/// sensor stands on a plane that passes through it.
+const NEAR_VIEWPOINT: f64 = 1.5;
+/// Live points of a plane within [`NEAR_VIEWPOINT`] that make it the floor
+/// the sensor stands on.
+const NEAR_SUPPORT: usize = 10;
 
 const START_K: usize = 4096;
 const MIN_RANKABLE: usize = 40;
@@ -140,8 +151,10 @@ const POOL_CAP: usize = 1 << 18;
 const LO_SAMPLE: usize = 16_384;
 
 impl PlanePool {
-    /// All of `pts` in play, shuffled once with `rng`.
-    pub fn new(pts: &[Vec3], sample_radius: f64, mut rng: Rng) -> Self {
+    /// All of `pts` in play, shuffled once with `rng`. With `edge_on` (the
+    /// sensor in the points' coordinates), planes seen edge-on from it are
+    /// never hypotheses.
+    pub fn new(pts: &[Vec3], sample_radius: f64, edge_on: Option<DVec3>, mut rng: Rng) -> Self {
         let n = pts.len();
         // The scoring pool: every point in random order, or beyond POOL_CAP
         // points a uniform random subset of POOL_CAP; every prefix is a
@@ -181,6 +194,22 @@ impl PlanePool {
             cell_box.push(((lo + hi) * 0.5, (hi - lo) * 0.5));
             cell_live.push(members.len() as u32);
         }
+        // The points near the viewpoint, found through the voxels' boxes.
+        let near = edge_on.map(|viewpoint| {
+            let r2 = NEAR_VIEWPOINT * NEAR_VIEWPOINT;
+            let mut near = Vec::new();
+            for (c, &(centre, half)) in cell_box.iter().enumerate() {
+                let gap = ((centre - viewpoint).abs() - half).max(DVec3::ZERO);
+                if gap.length_squared() <= r2 {
+                    for pos in buckets.range(c) {
+                        if cell_pts[pos].as_dvec3().distance_squared(viewpoint) <= r2 {
+                            near.push(pos as u32);
+                        }
+                    }
+                }
+            }
+            near
+        });
         let mut pool = PlanePool {
             pool_live: 0,
             cell_pts,
@@ -197,6 +226,7 @@ impl PlanePool {
             cell_of,
             voxels: buckets,
             rng,
+            near,
             work: 0,
         };
         for i in order.iter_mut() {
@@ -348,6 +378,9 @@ impl PlanePool {
                     continue;
                 };
                 let plane = plane_for(normal, offset);
+                if self.seen_edge_on(&plane, viewpoint, params) {
+                    continue;
+                }
                 // Cheap local test: the plane must explain a fair share of
                 // its own voxel, or the sample mixed surfaces / hit clutter.
                 if !self.locally_planar(&plane, cell) {
@@ -384,7 +417,9 @@ impl PlanePool {
                     threshold: best.threshold,
                     ..refit
                 };
-                if self.count(&same_t, 0, lo_k) >= self.count(&best, 0, lo_k) {
+                if !self.seen_edge_on(&refit, viewpoint, params)
+                    && self.count(&same_t, 0, lo_k) >= self.count(&best, 0, lo_k)
+                {
                     plane = refit;
                 }
             }
@@ -394,6 +429,39 @@ impl PlanePool {
             return None;
         }
         Some((plane, inliers, coords))
+    }
+
+    /// Does `plane` pass through the viewpoint (within two inlier
+    /// distances) without the sensor standing on it? Every ray to such a
+    /// plane grazes it: what lies on it is the laser rings of the beams at
+    /// the sensor's own elevation, across every surface around. As a
+    /// candidate it would be rejected (`seen_edge_on` in the cascade), and
+    /// the band it cut out of each facade, pole and car would leave play
+    /// with it, once per round, a little tilted each time; so such planes
+    /// are never hypotheses, and their points stay for the surfaces they
+    /// belong to. The sensor stands on the plane when [`NEAR_SUPPORT`] of its
+    /// live inliers lie within [`NEAR_VIEWPOINT`] of the viewpoint: a floor
+    /// under a low sensor is a plane like any other.
+    fn seen_edge_on(&self, plane: &LocalPlane, viewpoint: DVec3, params: &Params) -> bool {
+        let Some(near) = &self.near else {
+            return false;
+        };
+        if (plane.normal.dot(viewpoint) + plane.offset).abs() >= 2.0 * params.distance {
+            return false;
+        }
+        let (n, d, t) = (
+            plane.normal.as_vec3(),
+            plane.offset as f32,
+            plane.threshold as f32,
+        );
+        let on = near
+            .iter()
+            .filter(|&&v| {
+                self.alive[v as usize] && (n.dot(self.cell_pts[v as usize]) + d).abs() < t
+            })
+            .take(NEAR_SUPPORT)
+            .count();
+        on < NEAR_SUPPORT
     }
 
     /// Do at least 30 % of the live points of voxel `cell` lie on `plane`?
@@ -633,7 +701,7 @@ mod tests {
             );
             pts.push(p);
         }
-        PlanePool::new(&pts, 1.0, Rng::new(9))
+        PlanePool::new(&pts, 1.0, None, Rng::new(9))
     }
 
     fn plane(normal: DVec3, offset: f64) -> LocalPlane {
