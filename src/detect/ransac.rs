@@ -134,6 +134,8 @@ const NEAR_VIEWPOINT: f64 = 1.5;
 /// Live points of a plane within [`NEAR_VIEWPOINT`] that make it the floor
 /// the sensor stands on.
 const NEAR_SUPPORT: usize = 10;
+/// Most points near the viewpoint that are kept for that test.
+const NEAR_CAP: usize = 4096;
 
 const START_K: usize = 4096;
 const MIN_RANKABLE: usize = 40;
@@ -208,7 +210,11 @@ impl PlanePool {
                     }
                 }
             }
-            near
+            // An even-strided subset is enough to tell a floor under the
+            // sensor, and keeps each look bounded (a sensor close to
+            // surfaces has many points near it).
+            let step = near.len().div_ceil(NEAR_CAP).max(1);
+            near.into_iter().step_by(step).collect()
         });
         let mut pool = PlanePool {
             pool_live: 0,
