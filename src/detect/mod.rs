@@ -224,8 +224,26 @@ fn merge_pieces(
                 bad[labels[i] as usize] += (q.is_some() && !stay) as usize;
                 kept.push(stay);
             }
-            if !keeps_own || group.iter().any(|&j| 10 * bad[j] > total[j]) {
+            if group.iter().any(|&j| 10 * bad[j] > total[j]) {
                 continue;
+            }
+            // The largest keeps its own support inside the new region, or
+            // nine tenths of it (the larger footprint's trace can simplify
+            // another way); what it leaves outside loses its label.
+            let mut own_out = Vec::new();
+            if !keeps_own {
+                let mut own = 0usize;
+                for (i, &l) in labels.iter().enumerate() {
+                    if l == big as u32 {
+                        own += 1;
+                        if !region.contains(out.frame.to_local(world(i))) {
+                            own_out.push(i);
+                        }
+                    }
+                }
+                if 10 * own_out.len() > own {
+                    continue;
+                }
             }
             out.area = signed_area(&ring);
             out.outline = ring;
@@ -240,6 +258,11 @@ fn merge_pieces(
                     gone.push(world(i));
                 }
             }
+            for &i in &own_out {
+                labels[i] = NO_PRIMITIVE;
+                gone.push(world(i));
+            }
+            out.support -= own_out.len() as u64;
             for &j in &group {
                 out.moments.merge(&primitives[j].moments);
                 into[j] = big as u32;
