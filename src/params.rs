@@ -124,7 +124,8 @@ pub struct Params {
     /// at grazing angles with wide gaps between laser rings. Default 1.0.
     pub ground_alpha: f64,
     /// Raster cell size of footprints (m): the resolution of concave
-    /// outlines and of the occupancy test. Default 0.2.
+    /// outlines; the occupancy test counts blocks of 2 x 2 cells. Default
+    /// 0.2.
     pub cell: f64,
     /// Raster cell size of ground footprints (m): the ground is large and
     /// seen at grazing angles; a coarser cell makes its outline cheaper.
@@ -160,8 +161,10 @@ pub struct Params {
     /// Least support points per m^2 with `solidity: density`. Default 48
     /// (authors).
     pub min_density: f64,
-    /// Least occupied share of the area with `solidity: occupancy` (0..1).
-    /// Default 0.5.
+    /// Least occupied share of the area with `solidity: occupancy` (0..1):
+    /// the share of the outline's area in blocks of 2 x 2 footprint cells
+    /// that hold support (a far facade's laser rings lie more than a cell
+    /// apart). Default 0.5.
     pub min_occupancy: f64,
 
     // --- Cascade budget ---

@@ -48,10 +48,13 @@ impl Primitive {
         }
     }
 
-    /// Share of the outline's area whose footprint cells hold support (0..1).
+    /// Share of the outline's area whose footprint blocks of 2 x 2 cells
+    /// hold support (0..1). Blocks, not cells: a far facade's laser rings
+    /// lie farther apart than one cell (0.2 m by default) but cover the
+    /// surface at the sensor's resolution, and the outline closes them.
     pub fn occupancy(&self) -> f64 {
         if self.area > 0.0 {
-            (self.footprint.occupied_area() / self.area).min(1.0)
+            (self.footprint.occupied_block_area() / self.area).min(1.0)
         } else {
             0.0
         }

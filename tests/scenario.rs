@@ -238,15 +238,15 @@ fn drive_through(layout: Layout) {
     );
     assert!(inc.duplicates.count <= shot.duplicates.count, "duplicates");
     // polyscene's one-shot on the whole drive (measured, session 9: street
-    // P 0.905 R 0.346 C 0.772, 1 duplicate pair; crossing P 0.778 R 0.226
-    // C 0.757): the scenario is more precise, finds more of the scene,
-    // without duplicates. The one-shot's area-weighted mean error is the
-    // lower one (street 4.4 vs 8.6 mm, crossing 5.1 vs 6.0 mm): it fits each
+    // P 0.887 R 0.329 C 0.791, 1 duplicate pair; crossing P 0.848 R 0.220
+    // C 0.767, 1 pair): the scenario is more precise, finds more of the
+    // scene, without duplicates. The one-shot's area-weighted mean error is
+    // the lower one (street 4.6 vs 8.7 mm, crossing 4.8 vs 6.1 mm): it fits each
     // surface to the whole drive at once, and leaves out most of the
     // vehicle faces. So the mean is not compared here; BENCHMARKS.md gives
     // both. Since its ground clustering tolerance grows with range (session
     // 8), the one-shot also covers more of the crossing than the scenario
-    // (0.757 vs 0.714; the street: 0.772 vs 0.779): it sees the far road
+    // (0.767 vs 0.722; the street: 0.791 vs 0.778): it sees the far road
     // rings of all 100 scans at once, the scenario each scan's alone. The
     // scenario must cover at least nine tenths of what it covers.
     assert!(

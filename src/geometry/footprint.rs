@@ -342,6 +342,34 @@ impl Footprint {
         self.count() as f64 * self.cell * self.cell
     }
 
+    /// Area of the blocks of 2 x 2 cells (aligned on even cell indices)
+    /// that hold a set cell, in square metres: the occupied area at twice
+    /// the cell size.
+    pub fn occupied_block_area(&self) -> f64 {
+        if self.w == 0 || self.h == 0 {
+            return 0.0;
+        }
+        let (w, h) = (self.w as i64, self.h as i64);
+        let (bx0, by0) = (self.x0.div_euclid(2), self.y0.div_euclid(2));
+        let (bx1, by1) = (
+            (self.x0 + w - 1).div_euclid(2),
+            (self.y0 + h - 1).div_euclid(2),
+        );
+        let set = |x: i64, y: i64| {
+            let (x, y) = (x - self.x0, y - self.y0);
+            (0..w).contains(&x) && (0..h).contains(&y) && self.get_local(x as usize, y as usize)
+        };
+        let mut blocks = 0usize;
+        for by in by0..=by1 {
+            for bx in bx0..=bx1 {
+                let (x, y) = (2 * bx, 2 * by);
+                blocks +=
+                    (set(x, y) || set(x + 1, y) || set(x, y + 1) || set(x + 1, y + 1)) as usize;
+            }
+        }
+        blocks as f64 * 4.0 * self.cell * self.cell
+    }
+
     /// Centres of the set cells (frame coordinates), in row-major order.
     pub fn cell_centres(&self) -> Vec<DVec2> {
         let mut out = Vec::new();
@@ -1013,6 +1041,32 @@ mod tests {
         assert_eq!(small.mark_all(&[DVec2::new(1.0, 1.0)]), 1);
         assert!(small.is_set(DVec2::new(1.0, 1.0)));
         let _ = small.outline(0.5, 0.1, 64);
+    }
+
+    #[test]
+    fn block_area_counts_the_blocks_of_two_by_two_cells_with_support() {
+        assert_eq!(Footprint::new(0.2).occupied_block_area(), 0.0);
+        // Rows of points 0.45 m apart on 0.2 m cells: a laser ring pattern.
+        // About 1 cell row in 2.25 is set, but 8 block rows of 9.
+        let mut fp = Footprint::new(0.2);
+        let pts: Vec<DVec2> = (0..8)
+            .flat_map(|r| {
+                (0..40).map(move |i| DVec2::new(0.05 + 0.1 * i as f64, 0.07 + 0.45 * r as f64))
+            })
+            .collect();
+        fp.mark_all(&pts);
+        let cells = fp.occupied_area();
+        assert!((cells - 8.0 * 20.0 * 0.04).abs() < 1e-9, "{cells}");
+        // Rows in cells 0, 2, 4, 7, 9, 11, 13, 16: blocks 0-6 and 8; x in
+        // cells 0-19: blocks 0-9.
+        let blocks = fp.occupied_block_area();
+        assert!((blocks - 8.0 * 10.0 * 0.16).abs() < 1e-9, "{blocks}");
+        // Negative cell indices align the same way (floor division).
+        let mut neg = Footprint::new(0.2);
+        neg.mark_all(&[DVec2::new(-0.1, -0.1), DVec2::new(-0.3, -0.3)]);
+        assert!((neg.occupied_block_area() - 0.16).abs() < 1e-12);
+        neg.mark_all(&[DVec2::new(0.1, 0.1)]);
+        assert!((neg.occupied_block_area() - 0.32).abs() < 1e-12);
     }
 
     #[test]
