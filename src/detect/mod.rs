@@ -262,7 +262,7 @@ fn merge_pieces(
                 labels[i] = NO_PRIMITIVE;
                 gone.push(world(i));
             }
-            out.support -= own_out.len() as u64;
+            out.support = out.support.saturating_sub(own_out.len() as u64);
             for &j in &group {
                 out.moments.merge(&primitives[j].moments);
                 into[j] = big as u32;
