@@ -653,6 +653,24 @@ fn simulated_street_scans_and_a_location_meet_quality_floors() {
     );
 }
 
+/// 30 m x 30 m of flat ground (z = 0 +- 5 mm) around the origin, every 0.1 m.
+fn flat_ground(rng: &mut Rng) -> Vec<DVec3> {
+    let mut pts = Vec::new();
+    let corner = DVec3::new(-15.0, -15.0, 0.0);
+    rect(
+        &mut pts,
+        corner,
+        DVec3::X,
+        DVec3::Y,
+        30.0,
+        30.0,
+        0.1,
+        0.005,
+        rng,
+    );
+    pts
+}
+
 /// A sensor cannot see a surface it lies in: a plane through the viewpoint,
 /// away from it, is the laser rings at the sensor's own height (over a
 /// location they close into a few m^2 of false surface). Such a candidate
@@ -661,19 +679,7 @@ fn simulated_street_scans_and_a_location_meet_quality_floors() {
 #[test]
 fn planes_through_the_viewpoint_away_from_it_are_not_surfaces() {
     let mut rng = Rng::new(21);
-    let ground = |rng: &mut Rng, pts: &mut Vec<DVec3>| {
-        rect(
-            pts,
-            DVec3::new(-15.0, -15.0, 0.0),
-            DVec3::X,
-            DVec3::Y,
-            30.0,
-            30.0,
-            0.1,
-            0.005,
-            rng,
-        );
-    };
+    let ground = |rng: &mut Rng, pts: &mut Vec<DVec3>| pts.extend(flat_ground(rng));
     let patch_at = |z: f64, rng: &mut Rng| {
         let mut pts = Vec::new();
         ground(rng, &mut pts);
@@ -732,19 +738,8 @@ fn planes_through_the_viewpoint_away_from_it_are_not_surfaces() {
 #[test]
 fn the_ring_at_sensor_height_leaves_the_walls_their_band() {
     let mut rng = Rng::new(5);
-    let mut pts = Vec::new();
-    let (x, y, z) = (DVec3::X, DVec3::Y, DVec3::Z);
-    rect(
-        &mut pts,
-        DVec3::new(-15.0, -15.0, 0.0),
-        x,
-        y,
-        30.0,
-        30.0,
-        0.1,
-        0.005,
-        &mut rng,
-    );
+    let mut pts = flat_ground(&mut rng);
+    let (x, z) = (DVec3::X, DVec3::Z);
     let wall = pts.len()..{
         // 8 m x 4 m, 8 m in front of the sensor.
         rect(
@@ -824,19 +819,7 @@ fn the_ring_at_sensor_height_leaves_the_walls_their_band() {
 #[test]
 fn a_wall_seen_as_rings_farther_apart_than_a_cell_is_kept() {
     let mut rng = Rng::new(8);
-    let mut pts = Vec::new();
-    let (x, y) = (DVec3::X, DVec3::Y);
-    rect(
-        &mut pts,
-        DVec3::new(-15.0, -15.0, 0.0),
-        x,
-        y,
-        30.0,
-        30.0,
-        0.1,
-        0.005,
-        &mut rng,
-    );
+    let mut pts = flat_ground(&mut rng);
     for r in 0..8 {
         for i in 0..120 {
             let z = 0.3 + 0.49 * r as f64 + 0.002 * rng.gaussian();
