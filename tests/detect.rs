@@ -653,6 +653,18 @@ fn simulated_street_scans_and_a_location_meet_quality_floors() {
     );
 }
 
+/// gpp2 detection seen from `viewpoint`, its invariants checked.
+fn detect_checked(pts: &[DVec3], viewpoint: [f64; 3]) -> polyscene::detect::Detection {
+    let c = cloud(pts);
+    let p = Params {
+        viewpoint,
+        ..Params::gpp2()
+    };
+    let det = detect(&c, &p).unwrap();
+    check_invariants(&c, &det, &p);
+    det
+}
+
 /// 30 m x 30 m of flat ground (z = 0 +- 5 mm) around the origin, every 0.1 m.
 fn flat_ground(rng: &mut Rng) -> Vec<DVec3> {
     let mut pts = Vec::new();
@@ -764,13 +776,7 @@ fn the_ring_at_sensor_height_leaves_the_walls_their_band() {
             1.8 + 0.01 * rng.gaussian(),
         ));
     }
-    let c = cloud(&pts);
-    let p = Params {
-        viewpoint: [0.0, 0.0, 1.8],
-        ..Params::gpp2()
-    };
-    let det = detect(&c, &p).unwrap();
-    check_invariants(&c, &det, &p);
+    let det = detect_checked(&pts, [0.0, 0.0, 1.8]);
     // The wall's primitive: the label most of its points carry (those
     // above the ground's slab).
     let wall: Vec<usize> = wall.filter(|&i| pts[i].z > 0.1).collect();
@@ -830,13 +836,7 @@ fn a_wall_seen_as_rings_farther_apart_than_a_cell_is_kept() {
             ));
         }
     }
-    let c = cloud(&pts);
-    let p = Params {
-        viewpoint: [0.0, 0.0, 1.8],
-        ..Params::gpp2()
-    };
-    let det = detect(&c, &p).unwrap();
-    check_invariants(&c, &det, &p);
+    let det = detect_checked(&pts, [0.0, 0.0, 1.8]);
     let walls: Vec<_> = det
         .primitives
         .iter()
