@@ -820,8 +820,8 @@ fn the_ring_at_sensor_height_leaves_the_walls_their_band() {
 
 /// A far facade as a LiDAR sees it: laser rings 0.49 m apart, dense along
 /// each ring. Fewer than half of the 0.2 m cells inside its outline hold a
-/// point, but every 2 x 2 block row but one does: it is a solid surface at
-/// the sensor's resolution and is kept.
+/// point, but most of its blocks of 2 x 2 cells do: it is a solid surface
+/// at the sensor's resolution and is kept.
 #[test]
 fn a_wall_seen_as_rings_farther_apart_than_a_cell_is_kept() {
     let mut rng = Rng::new(8);
