@@ -131,12 +131,10 @@ fn pull_towards(flat: &mut [DVec2], foot: DVec2, range: f64) {
 /// between them).
 ///
 /// In the order found, a primitive and the newer pieces mergeable with it
-/// become one: the largest keeps its plane and frame and absorbs the others
-/// in one outline trace, provided each keeps nine tenths of its support
-/// within the inlier distance of that plane and inside the merged outline's
-/// raster region (and the largest all of its own); the points that do not
-/// lose their label. So the detection contract (support near its plane,
-/// inside its outline) holds.
+/// become one ([`absorb`]). A merged outline is larger and can touch a
+/// piece it did not touch before, so passes repeat until nothing merges;
+/// after the first, only groups with a primitive grown in the last pass
+/// are looked at.
 #[inline(never)]
 fn merge_pieces(
     primitives: &mut Vec<Primitive>,
@@ -149,16 +147,10 @@ fn merge_pieces(
     if n < 2 || p.hull != HullKind::Concave {
         return;
     }
-    let world = |i: usize| origin + pts[i].as_dvec3();
     let mut into: Vec<u32> = (0..n as u32).collect();
-    // Passes until nothing merges: a merged outline is larger and can
-    // touch a piece it did not touch before. After the first pass only
-    // groups with a primitive grown in the last one are looked at.
     let mut grown = vec![true; n];
     for _ in 0..n {
         let mut next = vec![false; n];
-        // In the order found; of a primitive and the newer pieces mergeable
-        // with it, the largest keeps its plane and frame.
         for first in 0..n {
             if into[first] != first as u32 {
                 continue;
@@ -174,102 +166,21 @@ fn merge_pieces(
                 continue;
             }
             group.push(first);
-            let mut big = first;
-            for &j in &group {
-                if primitives[j].area > primitives[big].area {
-                    big = j;
-                }
-            }
-            group.retain(|&j| j != big);
-            let mut out = primitives[big].clone();
-            let threshold = if out.ground {
-                p.ground_distance
-            } else {
-                p.distance
-            };
-            // The pieces' points, with their coordinates in `big`'s frame when
-            // they lie on its plane.
-            let mut taken: Vec<(usize, Option<DVec2>)> = Vec::new();
-            let (mut total, mut bad) = (vec![0usize; n], vec![0usize; n]);
-            let mut in_group = vec![false; n];
-            for &j in &group {
-                in_group[j] = true;
-            }
-            for (i, &l) in labels.iter().enumerate() {
-                if l != NO_PRIMITIVE && in_group[l as usize] {
-                    let w = world(i);
-                    let on = out.plane.signed_distance(w).abs() < threshold;
-                    total[l as usize] += 1;
-                    bad[l as usize] += !on as usize;
-                    taken.push((i, on.then(|| out.frame.to_local(w))));
-                }
-            }
-            let marks: Vec<DVec2> = taken.iter().filter_map(|t| t.1).collect();
-            out.footprint.mark_all(&marks);
-            let Some((ring, region)) =
-                out.footprint
-                    .outline_region(out.alpha(p), p.simplify, p.max_vertices)
-            else {
-                continue;
-            };
-            // (`out` is `big` with the pieces' cells added: same frame.)
-            let keeps_own = primitives[big]
-                .footprint
-                .cell_centres()
-                .iter()
-                .all(|&c| region.contains(c));
-            let mut kept = Vec::with_capacity(taken.len());
-            for &(i, q) in &taken {
-                let stay = q.is_some_and(|q| region.contains(q));
-                bad[labels[i] as usize] += (q.is_some() && !stay) as usize;
-                kept.push(stay);
-            }
-            if group.iter().any(|&j| 10 * bad[j] > total[j]) {
-                continue;
-            }
-            // The largest keeps its own support inside the new region, or
-            // nine tenths of it (the larger footprint's trace can simplify
-            // another way); what it leaves outside loses its label.
-            let mut own_out = Vec::new();
-            if !keeps_own {
-                let mut own = 0usize;
-                for (i, &l) in labels.iter().enumerate() {
-                    if l == big as u32 {
-                        own += 1;
-                        if !region.contains(out.frame.to_local(world(i))) {
-                            own_out.push(i);
-                        }
-                    }
-                }
-                if 10 * own_out.len() > own {
-                    continue;
-                }
-            }
-            out.area = signed_area(&ring);
-            out.outline = ring;
-            out.footprint.retain_region(&region);
-            let mut gone = Moments::new(out.moments.reference);
-            for (&(i, _), &stay) in taken.iter().zip(&kept) {
-                if stay {
-                    labels[i] = big as u32;
-                    out.support += 1;
+            let big = group.iter().copied().fold(first, |b, j| {
+                if primitives[j].area > primitives[b].area {
+                    j
                 } else {
-                    labels[i] = NO_PRIMITIVE;
-                    gone.push(world(i));
+                    b
                 }
+            });
+            group.retain(|&j| j != big);
+            if let Some(out) = absorb(primitives, labels, big, &group, pts, origin, p) {
+                primitives[big] = out;
+                for &j in &group {
+                    into[j] = big as u32;
+                }
+                next[big] = true;
             }
-            for &i in &own_out {
-                labels[i] = NO_PRIMITIVE;
-                gone.push(world(i));
-            }
-            out.support = out.support.saturating_sub(own_out.len() as u64);
-            for &j in &group {
-                out.moments.merge(&primitives[j].moments);
-                into[j] = big as u32;
-            }
-            out.moments.remove(&gone);
-            primitives[big] = out;
-            next[big] = true;
         }
         if !next.contains(&true) {
             break;
@@ -531,6 +442,109 @@ impl<'p> Detector<'p> {
             time_ms: clock::now_ms() - t0,
         }
     }
+}
+
+/// `primitives[big]` with the pieces `group` absorbed, or `None` when the
+/// merge would break the detection contract (support near its plane,
+/// inside its outline). The largest keeps its plane and frame; the pieces'
+/// points on that plane mark its footprint, and one outline trace follows.
+/// Each piece must keep nine tenths of its support within the inlier
+/// distance of the plane and inside the new raster region, and so must the
+/// largest (the larger footprint's trace can simplify another way); the
+/// points that do not lose their label. Labels are changed only on success.
+fn absorb(
+    primitives: &[Primitive],
+    labels: &mut [u32],
+    big: usize,
+    group: &[usize],
+    pts: &[Vec3],
+    origin: DVec3,
+    p: &Params,
+) -> Option<Primitive> {
+    let n = primitives.len();
+    let world = |i: usize| origin + pts[i].as_dvec3();
+    let mut out = primitives[big].clone();
+    let threshold = if out.ground {
+        p.ground_distance
+    } else {
+        p.distance
+    };
+    // The pieces' points, with their coordinates in `big`'s frame when they
+    // lie on its plane.
+    let mut taken: Vec<(usize, Option<DVec2>)> = Vec::new();
+    let (mut total, mut bad) = (vec![0usize; n], vec![0usize; n]);
+    let mut in_group = vec![false; n];
+    for &j in group {
+        in_group[j] = true;
+    }
+    for (i, &l) in labels.iter().enumerate() {
+        if l != NO_PRIMITIVE && in_group[l as usize] {
+            let w = world(i);
+            let on = out.plane.signed_distance(w).abs() < threshold;
+            total[l as usize] += 1;
+            bad[l as usize] += !on as usize;
+            taken.push((i, on.then(|| out.frame.to_local(w))));
+        }
+    }
+    let marks: Vec<DVec2> = taken.iter().filter_map(|t| t.1).collect();
+    out.footprint.mark_all(&marks);
+    let (ring, region) = out
+        .footprint
+        .outline_region(out.alpha(p), p.simplify, p.max_vertices)?;
+    let mut kept = Vec::with_capacity(taken.len());
+    for &(i, q) in &taken {
+        let stay = q.is_some_and(|q| region.contains(q));
+        bad[labels[i] as usize] += (q.is_some() && !stay) as usize;
+        kept.push(stay);
+    }
+    if group.iter().any(|&j| 10 * bad[j] > total[j]) {
+        return None;
+    }
+    // `out` is `big` with the pieces' cells added (same frame): when the
+    // region holds all of `big`'s cells it holds all of its points.
+    let keeps_own = primitives[big]
+        .footprint
+        .cell_centres()
+        .iter()
+        .all(|&c| region.contains(c));
+    let mut own_out = Vec::new();
+    if !keeps_own {
+        let mut own = 0usize;
+        for (i, &l) in labels.iter().enumerate() {
+            if l == big as u32 {
+                own += 1;
+                if !region.contains(out.frame.to_local(world(i))) {
+                    own_out.push(i);
+                }
+            }
+        }
+        if 10 * own_out.len() > own {
+            return None;
+        }
+    }
+    out.area = signed_area(&ring);
+    out.outline = ring;
+    out.footprint.retain_region(&region);
+    let mut gone = Moments::new(out.moments.reference);
+    for (&(i, _), &stay) in taken.iter().zip(&kept) {
+        if stay {
+            labels[i] = big as u32;
+            out.support += 1;
+        } else {
+            labels[i] = NO_PRIMITIVE;
+            gone.push(world(i));
+        }
+    }
+    for &i in &own_out {
+        labels[i] = NO_PRIMITIVE;
+        gone.push(world(i));
+    }
+    out.support = out.support.saturating_sub(own_out.len() as u64);
+    for &j in group {
+        out.moments.merge(&primitives[j].moments);
+    }
+    out.moments.remove(&gone);
+    Some(out)
 }
 
 #[cfg(test)]
