@@ -85,6 +85,14 @@ pub fn detect(cloud: &Cloud, params: &Params) -> Result<Detection> {
     Ok(Detector::new(params).run(&cloud.points, cloud.origin, viewpoint))
 }
 
+/// Does a plane at signed distance `d` from the viewpoint pass through it
+/// (within two inlier distances)? Every ray from the sensor to such a plane
+/// grazes it. The test of both the RANSAC hypotheses (one-shot detection)
+/// and the candidates.
+pub(crate) fn through_viewpoint(d: f64, p: &Params) -> bool {
+    d.abs() < 2.0 * p.distance
+}
+
 /// Is this candidate a plane the sensor lies in, away from it? Its plane
 /// passes within two inlier distances of the viewpoint, so every ray to it
 /// grazes, and the viewpoint's foot point is more than a metre outside its
@@ -95,7 +103,7 @@ pub fn detect(cloud: &Cloud, params: &Params) -> Result<Detection> {
 /// arcs they draw on poles and trunks pass the normal-consistency test.
 fn seen_edge_on(s: &Shaped, viewpoint: DVec3, p: &Params) -> bool {
     let prim = &s.primitive;
-    if prim.plane.signed_distance(viewpoint).abs() >= 2.0 * p.distance {
+    if !through_viewpoint(prim.plane.signed_distance(viewpoint), p) {
         return false;
     }
     let foot = prim.frame.to_local(viewpoint);

@@ -452,7 +452,7 @@ impl PlanePool {
         let Some(near) = &self.near else {
             return false;
         };
-        if (plane.normal.dot(viewpoint) + plane.offset).abs() >= 2.0 * params.distance {
+        if !super::through_viewpoint(plane.normal.dot(viewpoint) + plane.offset, params) {
             return false;
         }
         let (n, d, t) = (
