@@ -251,12 +251,16 @@ fn normal_consistency(
 
 /// PCA refit, frame, footprint, outline and area of a support set given in
 /// local coordinates relative to `origin`. `None` for degenerate sets (fewer
-/// than three points, collinear) or when no outline exists.
+/// than three points, collinear) or when no outline exists. With
+/// `ring_gaps` (one-shot detection, whose ground clustering grows with
+/// range), a ground footprint also fills the gaps between laser rings that
+/// the clustering bridged ([`Footprint::bridge_towards`]).
 pub(crate) fn shape(
     origin: DVec3,
     pts: &[Vec3],
     params: &Params,
     viewpoint: DVec3,
+    ring_gaps: bool,
 ) -> Option<Shaped> {
     // World coordinates, once: every pass below reads them.
     let world: Vec<DVec3> = pts.iter().map(|p| origin + p.as_dvec3()).collect();
@@ -303,6 +307,15 @@ pub(crate) fn shape(
     };
     let mut footprint = Footprint::new(cell);
     footprint.mark_all(&q_near);
+    if ground && ring_gaps {
+        footprint.bridge_towards(
+            frame.to_local(viewpoint),
+            params.ground_cluster_range,
+            params.ground_cluster_tolerance,
+            // Narrower gaps are closed by the outline anyway.
+            2.0 * alpha - cell,
+        );
+    }
     let (outline, kept, region) = match params.hull {
         HullKind::Convex => {
             let h = cap_convex(convex_hull(&q_near)?, params);

@@ -398,7 +398,7 @@ impl<'p> Detector<'p> {
                     break;
                 }
                 // 3-4. PCA refit, frame, outline, area and solidity.
-                let shaped = shape(origin, support_pts, p, viewpoint);
+                let shaped = shape(origin, support_pts, p, viewpoint, self.whole_planes);
                 if k == 0 {
                     step.area = shaped.as_ref().map_or(0.0, |s| s.primitive.area);
                 }
@@ -581,7 +581,7 @@ mod tests {
         let mut prims = Vec::new();
         let mut labels = Vec::new();
         for (id, pts) in patches.iter().enumerate() {
-            let s = shape(DVec3::ZERO, pts, p, view).unwrap();
+            let s = shape(DVec3::ZERO, pts, p, view, false).unwrap();
             assert!(s.kept.iter().all(|&k| k));
             let mut prim = s.primitive;
             prim.id = id as u32;

@@ -29,6 +29,8 @@ pub const MAX_TRACE_CELLS: usize = 4_000_000;
 /// (and the index arithmetic within `usize` on wasm32) whatever the input.
 pub const MAX_CELLS: u64 = 1 << 30;
 const MAX_OFFSET: i128 = 1 << 40;
+/// Longest gap, in cells, that [`Footprint::bridge_towards`] fills.
+pub const MAX_TRAIL: usize = 256;
 
 /// A growable occupancy bit grid in a plane's 2D frame.
 ///
@@ -381,6 +383,49 @@ impl Footprint {
             }
         }
         out
+    }
+
+    /// Bridge the gaps between laser rings that the ground's clustering
+    /// bridged: from each set cell farther than `range` from `foot`, walk
+    /// towards `foot`; when a set cell lies within `tol r^2 / (range^2 +
+    /// tol r)` of the start (`r` its distance from `foot`: how far back
+    /// along the line of sight a point lies that is `tol` away once both
+    /// are pulled towards `foot` as the ground's clustering does), set the
+    /// cells in between. Only gaps with set cells on both sides are filled,
+    /// never the area in front of the nearest points, and only those at
+    /// least `narrowest` wide (an outline's closing fills the narrower
+    /// ones). Each walk is at most [`MAX_TRAIL`] cells; the walks read the
+    /// cells as they were before. Returns how many cells were newly set.
+    #[inline(never)]
+    pub fn bridge_towards(&mut self, foot: DVec2, range: f64, tol: f64, narrowest: f64) -> usize {
+        if !(range > 0.0 && tol > 0.0 && foot.is_finite()) {
+            return 0;
+        }
+        let step = self.cell;
+        // NaN and negative widths start at the nearest possible gap.
+        let first = ((narrowest / step).ceil() as usize).clamp(2, MAX_TRAIL + 1);
+        let mut fill: Vec<DVec2> = Vec::new();
+        for y in 0..self.h {
+            self.row_set_cells(y, |x| {
+                let c = self.centre(self.x0 + x as i64, self.y0 + y as i64);
+                let d = foot - c;
+                // std sqrt: one instruction in wasm, the same bits everywhere.
+                let r = d.length_squared().sqrt();
+                if !(r > range) {
+                    return;
+                }
+                let k = tol * r / (range * range);
+                let reach = ((r * k / (1.0 + k)) / step) as usize;
+                let u = d * (step / r);
+                if let Some(j) =
+                    (first..=reach.min(MAX_TRAIL)).find(|&j| self.is_set(c + u * j as f64))
+                {
+                    fill.extend((1..j).map(|i| c + u * i as f64));
+                }
+            });
+        }
+        // Between two set cells: inside the grid, which does not grow.
+        self.mark_all(&fill)
     }
 
     fn centre(&self, ix: i64, iy: i64) -> DVec2 {
@@ -1067,6 +1112,42 @@ mod tests {
         assert!((neg.occupied_block_area() - 0.16).abs() < 1e-12);
         neg.mark_all(&[DVec2::new(0.1, 0.1)]);
         assert!((neg.occupied_block_area() - 0.32).abs() < 1e-12);
+    }
+
+    #[test]
+    fn bridges_only_gaps_between_rings_that_the_range_allows() {
+        // Foot at the origin, range 20 m, tolerance 0.5 m: at 60 m the
+        // reach is 0.5 * 3600 / (400 + 30) = 4.19 m.
+        let at = |x: f64| DVec2::new(x, 0.1);
+        let mut fp = Footprint::new(0.2);
+        // Ring pairs 3 m apart (bridged) at 60 m, 6 m apart (not) at 40 m
+        // (reach 1.90 m), and a lone point at 30 m.
+        fp.mark_all(&[at(57.1), at(60.1), at(34.1), at(40.1), at(30.1)]);
+        let before = fp.count();
+        let fresh = fp.bridge_towards(DVec2::ZERO, 20.0, 0.5, 0.0);
+        assert_eq!(fresh, 14, "the cells strictly between 57.1 and 60.1");
+        assert_eq!(fp.count(), before + 14);
+        for x in [57.3, 58.5, 59.9] {
+            assert!(fp.is_set(at(x)), "{x}");
+        }
+        for x in [56.9, 35.0, 39.9, 29.9, 60.3] {
+            assert!(!fp.is_set(at(x)), "{x}");
+        }
+        // Gaps narrower than asked for are left.
+        let mut narrow = Footprint::new(0.2);
+        narrow.mark_all(&[at(57.1), at(60.1)]);
+        assert_eq!(narrow.bridge_towards(DVec2::ZERO, 20.0, 0.5, 3.1), 0);
+        assert_eq!(narrow.bridge_towards(DVec2::ZERO, 20.0, 0.5, 2.9), 14);
+        // Inside the range nothing is bridged, and bad arguments are no-ops.
+        let mut near = Footprint::new(0.2);
+        near.mark_all(&[at(10.1), at(11.1)]);
+        assert_eq!(near.bridge_towards(DVec2::ZERO, 20.0, 0.5, 0.0), 0);
+        assert_eq!(fp.bridge_towards(DVec2::NAN, 20.0, 0.5, 0.0), 0);
+        assert_eq!(fp.bridge_towards(DVec2::ZERO, 0.0, 0.5, 0.0), 0);
+        assert_eq!(fp.bridge_towards(DVec2::ZERO, 20.0, f64::NAN, 0.0), 0);
+        let mut nan = Footprint::new(0.2);
+        nan.mark_all(&[at(57.1), at(60.1)]);
+        assert_eq!(nan.bridge_towards(DVec2::ZERO, 20.0, 0.5, f64::NAN), 14);
     }
 
     #[test]
