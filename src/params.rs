@@ -109,9 +109,10 @@ pub struct Params {
     /// beyond the cloud's extent turns it off. One-shot detection only: the
     /// scenario detects its leftovers with the paper's cascade and fixed
     /// tolerances (with this growth there it measured neutral, see
-    /// BENCHMARKS.md, session 8). The outline's closing radius
-    /// (`groundAlpha`) does not grow: rings more than `2 * groundAlpha`
-    /// apart stay out of the ground's polygon.
+    /// BENCHMARKS.md, session 8). The ground's footprint then fills the
+    /// gaps along the line of sight that this clustering bridged (those
+    /// wider than `groundAlpha`'s closing fills), so its outline follows
+    /// every ring the clustering joined.
     pub ground_cluster_range: f64,
 
     // --- Outline ---
