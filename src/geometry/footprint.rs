@@ -411,7 +411,7 @@ impl Footprint {
                 let d = foot - c;
                 // std sqrt: one instruction in wasm, the same bits everywhere.
                 let r = d.length_squared().sqrt();
-                if !(r > range) {
+                if r.is_nan() || r <= range {
                     return;
                 }
                 let k = tol * r / (range * range);
