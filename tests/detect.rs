@@ -600,10 +600,11 @@ fn simulated_street_scans_and_a_location_meet_quality_floors() {
     // (session 8, the ground's tolerance growing beyond 20 m): 0.268,
     // 2.6 mm, 0.567; (session 9, planes seen edge-on no hypotheses, so
     // the facades keep their bands at the sensor's height): 0.316, 2.5 mm,
-    // 0.603; (occupancy on 2 x 2-cell blocks) 0.321, 2.6 mm, 0.620.
-    assert!(recall > 0.29, "recall {recall}");
+    // 0.603; (occupancy on 2 x 2-cell blocks) 0.321, 2.6 mm, 0.620;
+    // (session 10, no sliver samples) 0.350, 2.7 mm, 0.650.
+    assert!(recall > 0.33, "recall {recall}");
     assert!(mean < 0.004, "mean one-sided Hausdorff {mean}");
-    assert!(completeness > 0.59, "completeness {completeness}");
+    assert!(completeness > 0.635, "completeness {completeness}");
 
     let loc = drive.location(0, 10).unwrap();
     let cloud = Cloud::from_world_f64(&loc.points).unwrap();
@@ -641,9 +642,10 @@ fn simulated_street_scans_and_a_location_meet_quality_floors() {
     // tolerance maps the road's far rings (0.708 without it); (session 9)
     // 0.962, 0.792, 2.8 mm; with occupancy on 2 x 2-cell blocks 0.980,
     // 0.807, 2.6 mm; (session 10, the ground's footprint bridging the far
-    // rings' gaps) 0.982, 0.826, 2.7 mm.
+    // rings' gaps) 0.982, 0.826, 2.7 mm; (no sliver samples) 0.986, 0.888,
+    // 2.8 mm.
     assert!(
-        m.completeness.completeness > 0.80,
+        m.completeness.completeness > 0.85,
         "location completeness {}",
         m.completeness.completeness
     );

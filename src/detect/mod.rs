@@ -276,6 +276,9 @@ impl<'p> Detector<'p> {
             self.whole_planes.then_some(viewpoint - origin),
             rng,
         );
+        if self.whole_planes {
+            pool = pool.reject_slivers();
+        }
         let mut labels = vec![NO_PRIMITIVE; pts.len()];
         let mut primitives: Vec<Primitive> = Vec::new();
         let mut steps = Vec::new();
