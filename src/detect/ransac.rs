@@ -251,7 +251,7 @@ impl PlanePool {
     }
 
     /// Draw no sliver triples: the triangle of the three sample points must
-    /// be at least [`MIN_FATNESS`] times as high, on its longest side, as
+    /// be at least 0.15 times (`MIN_FATNESS`) as high, on its longest side, as
     /// that side is long. Three points almost in a line fix the line, not
     /// the plane: the noise across it tilts the plane at random, and what
     /// comes out most often is a plane across a wall through a thin band of
