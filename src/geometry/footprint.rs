@@ -396,6 +396,8 @@ impl Footprint {
     /// least `narrowest` wide (an outline's closing fills the narrower
     /// ones). Each walk is at most [`MAX_TRAIL`] cells; the walks read the
     /// cells as they were before. Returns how many cells were newly set.
+    // Not inlined: it runs once per ground candidate of one-shot detection,
+    // and its code stays out of the shape step it is called from.
     #[inline(never)]
     pub fn bridge_towards(&mut self, foot: DVec2, range: f64, tol: f64, narrowest: f64) -> usize {
         if !(range > 0.0 && tol > 0.0 && foot.is_finite()) {
