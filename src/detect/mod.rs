@@ -110,20 +110,20 @@ fn seen_edge_on(s: &Shaped, viewpoint: DVec3, p: &Params) -> bool {
     !contains(&prim.outline, foot) && distance(&prim.outline, foot) > 1.0
 }
 
-/// Pull the points farther than `range` from `foot` towards it, a point at
-/// distance `r` to `2 range - range^2 / r` (continuous and increasing, so
-/// nothing crosses): clustering the pulled points with a fixed tolerance `t`
-/// connects, at distance `r`, points `t (r / range)^2` apart along the line
-/// from `foot` and about `t r / (2 range)` across it. On the ground, the gap
-/// between neighbouring laser rings grows with the square of the range and
-/// the spacing along a ring linearly.
+/// Pull the points farther than `range` from `foot` towards it
+/// ([`crate::geometry::pull_range`]; nothing crosses): clustering the pulled
+/// points with a fixed tolerance `t` connects, at distance `r`, points
+/// `t (r / range)^2` apart along the line from `foot` and about
+/// `t r / (2 range)` across it. On the ground, the gap between neighbouring
+/// laser rings grows with the square of the range and the spacing along a
+/// ring linearly.
 fn pull_towards(flat: &mut [DVec2], foot: DVec2, range: f64) {
     for q in flat {
         let d = *q - foot;
         // std sqrt: one instruction in wasm, the same bits everywhere.
         let r = d.length_squared().sqrt();
         if r > range {
-            *q = foot + d * ((2.0 - range / r) * range / r);
+            *q = foot + d * (crate::geometry::pull_range(r, range) / r);
         }
     }
 }

@@ -387,11 +387,9 @@ impl Footprint {
 
     /// Bridge the gaps between laser rings that the ground's clustering
     /// bridged: from each set cell farther than `range` from `foot`, walk
-    /// towards `foot`; when a set cell lies within `tol r^2 / (range^2 +
-    /// tol r)` of the start (`r` its distance from `foot`: how far back
-    /// along the line of sight a point lies that is `tol` away once both
-    /// are pulled towards `foot` as the ground's clustering does), set the
-    /// cells in between. Only gaps with set cells on both sides are filled,
+    /// towards `foot`; when a set cell lies within the clustering's reach
+    /// (back along the line of sight to where the distance after pulling,
+    /// [`super::pull_range`], is `tol` less), set the cells in between. Only gaps with set cells on both sides are filled,
     /// never the area in front of the nearest points, and only those at
     /// least `narrowest` wide (an outline's closing fills the narrower
     /// ones). Each walk is at most [`MAX_TRAIL`] cells; the walks read the
@@ -416,8 +414,9 @@ impl Footprint {
                 if r.is_nan() || r <= range {
                     return;
                 }
-                let k = tol * r / (range * range);
-                let reach = ((r * k / (1.0 + k)) / step) as usize;
+                // Not past the foot, whatever the tolerance.
+                let back = super::unpull_range(super::pull_range(r, range) - tol, range).max(0.0);
+                let reach = ((r - back) / step) as usize;
                 let u = d * (step / r);
                 if let Some(j) =
                     (first..=reach.min(MAX_TRAIL)).find(|&j| self.is_set(c + u * j as f64))

@@ -13,6 +13,32 @@ pub use hull::convex_hull;
 pub use plane::{Frame, Moments, Plane, UP};
 pub use polygon::Polygon3;
 
+/// The ground's range pulling (one-shot detection): a distance `r` from the
+/// viewpoint's foot beyond `range` becomes `2 range - range^2 / r`
+/// (continuous and increasing, below `2 range`); nearer ones stay. Points
+/// a fixed tolerance `t` apart after pulling are `t (r / range)^2` apart
+/// along the line of sight before it, as the gaps between laser rings on
+/// the ground grow. Shared by the clustering (`detect::pull_towards`) and
+/// the footprint that fills what it bridged ([`Footprint::bridge_towards`]).
+pub(crate) fn pull_range(r: f64, range: f64) -> f64 {
+    if r > range {
+        (2.0 - range / r) * range
+    } else {
+        r
+    }
+}
+
+/// The inverse of [`pull_range`]; infinite from `2 range` on.
+pub(crate) fn unpull_range(q: f64, range: f64) -> f64 {
+    if q >= 2.0 * range {
+        f64::INFINITY
+    } else if q > range {
+        range * range / (2.0 * range - q)
+    } else {
+        q
+    }
+}
+
 /// Grow the box `[lo, hi]` to hold `p`, by comparisons written as selects.
 /// (`f64::min` and `max` become library calls in wasm, whose `f64.min`
 /// treats NaN differently; these loops run once per point. As selects they
@@ -98,6 +124,30 @@ pub(crate) fn heap_sort_by<T: Copy>(
 
 #[cfg(test)]
 mod tests {
+    use super::{pull_range, unpull_range};
+
+    #[test]
+    fn range_pulling_is_continuous_increasing_and_inverted() {
+        let range = 20.0;
+        assert_eq!(pull_range(10.0, range), 10.0);
+        assert_eq!(pull_range(20.0, range), 20.0);
+        assert!((pull_range(40.0, range) - 30.0).abs() < 1e-12);
+        assert!(pull_range(1e9, range) < 40.0);
+        let mut last = 0.0;
+        for k in 1..2000 {
+            let r = k as f64 * 0.1;
+            let q = pull_range(r, range);
+            assert!(q > last, "increasing at {r}");
+            assert!(
+                (unpull_range(q, range) - r).abs() < 1e-9 * r.max(1.0),
+                "{r}"
+            );
+            last = q;
+        }
+        assert_eq!(unpull_range(40.0, range), f64::INFINITY);
+        assert_eq!(unpull_range(-3.0, range), -3.0);
+    }
+
     #[test]
     fn heap_sort_matches_sort_by_on_a_total_order() {
         let mut rng = crate::rng::Rng::new(5);
