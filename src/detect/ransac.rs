@@ -34,15 +34,17 @@
 //! - **Adaptive stop.** After each improvement the number of hypotheses
 //!   needed for `confidence` is recomputed from the best inlier ratio (with
 //!   an assumed chance of 1/2 that a local triple started on a plane stays on it), bounded by
-//!   `[24, max_hypotheses]`.
+//!   `[24, max_hypotheses]` (twice that with the plain sampler; see
+//!   [`Params::max_hypotheses`]). Rounds after the large surfaces hit the
+//!   bound: their best planes hold a percent or two of the points left.
 //! - **Local optimisation and confirmation.** The best hypothesis is refit
 //!   by robust least squares (f64 PCA, trimmed) on its inliers among a
 //!   random subsample of at most 16 384 points; it replaces the hypothesis
 //!   when it scores at least as well there (with the same threshold), and
 //!   its inliers are then collected once from all remaining points.
 //!
-//! Bounds on work per primitive: at most `max_hypotheses * k` distance
-//! evaluations per prefix size (and at most `4 * max_hypotheses` samples),
+//! Bounds on work per round (`h` the bound on hypotheses above): at most
+//! `h * k` distance evaluations per prefix size (and at most `4 h` samples),
 //! prefix sizes grow geometrically to `n`, plus three passes over at most
 //! 16 384 points for the local optimisation and at most one pass over the
 //! `n` remaining points (with a test per live voxel) to collect the inliers.
@@ -130,6 +132,8 @@ pub struct PlanePool {
     min_fatness: f64,
     /// Point-to-plane distance evaluations so far.
     pub work: u64,
+    /// Hypotheses scored so far.
+    scored: u64,
 }
 
 /// Radius (m) around the viewpoint within which points tell whether the
@@ -242,6 +246,7 @@ impl PlanePool {
             near,
             min_fatness: 0.0,
             work: 0,
+            scored: 0,
         };
         for i in order.iter_mut() {
             *i = pool.cell_pos_of[*i as usize];
@@ -261,6 +266,18 @@ impl PlanePool {
     pub fn reject_slivers(mut self) -> Self {
         self.min_fatness = MIN_FATNESS;
         self
+    }
+
+    /// Most hypotheses scored per round: `max_hypotheses` with sliver
+    /// triples redrawn (one-shot detection), twice that with the plain
+    /// sampler (the paper's cascade and the scenario). See
+    /// [`Params::max_hypotheses`] for why.
+    fn hypothesis_budget(&self, params: &Params) -> usize {
+        if self.min_fatness > 0.0 {
+            params.max_hypotheses
+        } else {
+            params.max_hypotheses.saturating_mul(2)
+        }
     }
 
     /// Original index of position `v`.
@@ -397,9 +414,10 @@ impl PlanePool {
         let mut k = n.min(START_K);
         let best = loop {
             let mut best: Option<(LocalPlane, f64)> = None;
-            let mut needed = params.max_hypotheses;
+            let budget = self.hypothesis_budget(params);
+            let mut needed = budget;
             let (mut t, mut attempts) = (0, 0);
-            while t < needed.min(params.max_hypotheses) && attempts < 4 * params.max_hypotheses {
+            while t < needed.min(budget) && attempts < 4 * budget {
                 attempts += 1;
                 let Some((normal, offset, cell)) = self.sample() else {
                     continue;
@@ -414,6 +432,7 @@ impl PlanePool {
                     continue;
                 }
                 t += 1;
+                self.scored += 1;
                 let score = self.score_prefix(&plane, k, best.map_or(0.0, |b| b.1));
                 if best.is_none_or(|b| score > b.1) {
                     best = Some((plane, score));
@@ -785,6 +804,38 @@ mod tests {
             "with slivers: {plain} of {plain_n} on the wall"
         );
         assert!(fat_n > 1000, "{fat_n} samples drawn");
+    }
+
+    /// Points scattered through a 10 m cube hold no plane any sample could
+    /// find well supported, so a round scores as many hypotheses as it may:
+    /// `max_hypotheses` with slivers redrawn, twice that without.
+    #[test]
+    fn a_round_scores_at_most_its_hypothesis_budget() {
+        let mut rng = Rng::new(6);
+        let pts: Vec<Vec3> = (0..20_000)
+            .map(|_| {
+                Vec3::new(
+                    rng.range(0.0, 10.0) as f32,
+                    rng.range(0.0, 10.0) as f32,
+                    rng.range(0.0, 10.0) as f32,
+                )
+            })
+            .collect();
+        let params = Params {
+            min_inliers: 3,
+            ..Params::gpp2()
+        };
+        for (reject, budget) in [
+            (true, params.max_hypotheses),
+            (false, 2 * params.max_hypotheses),
+        ] {
+            let mut pool = PlanePool::new(&pts, 1.0, None, Rng::new(7));
+            if reject {
+                pool = pool.reject_slivers();
+            }
+            pool.best_plane(&params, DVec3::new(5.0, 5.0, 20.0));
+            assert_eq!(pool.scored, budget as u64, "slivers redrawn: {reject}");
+        }
     }
 
     fn plane(normal: DVec3, offset: f64) -> LocalPlane {
