@@ -40,12 +40,13 @@ if has python; then
       "$py" -m pip install -q --disable-pip-version-check "open3d==$OPEN3D_VERSION" ||
         say "pip could not install open3d $OPEN3D_VERSION: the Open3D rows will be skipped"
     fi
-    # open3d's wheel links libGL and libgomp; a headless machine may lack them.
+    # open3d's wheel links libGL, libEGL, libgomp, TBB and libusb; a headless
+    # machine may lack them (a fresh one here lacked TBB and libusb).
     if "$py" -c "import importlib.metadata as m; m.version('open3d')" 2>/dev/null &&
        ! "$py" -c "import open3d" 2>/dev/null; then
-      say "open3d does not import; installing the shared libraries it needs (libgl1, libgomp1)"
+      say "open3d does not import; installing the shared libraries it needs (libgl1, libegl1, libgomp1, libtbb12, libusb-1.0-0)"
       SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO=sudo
-      { $SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq libgl1 libgomp1 >/dev/null; } ||
+      { $SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq libgl1 libegl1 libgomp1 libtbb12 libusb-1.0-0 >/dev/null; } ||
         say "apt-get failed"
       "$py" -c "import open3d" 2>/dev/null || say "open3d still does not import: the Open3D rows will be skipped"
     fi
