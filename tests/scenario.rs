@@ -237,16 +237,16 @@ fn drive_through(layout: Layout) {
         "completeness"
     );
     assert!(inc.duplicates.count <= shot.duplicates.count, "duplicates");
-    // polyscene's one-shot on the whole drive (measured, session 10: street
-    // P 0.940 R 0.378 C 0.831, 1 duplicate pair; crossing P 0.947 R 0.273
-    // C 0.786, 2 pairs): the scenario is more precise, finds more of the
+    // polyscene's one-shot on the whole drive (measured, session 11: street
+    // P 0.931 R 0.360 C 0.800, no duplicates; crossing P 0.950 R 0.279
+    // C 0.800, 2 pairs): the scenario is more precise, finds more of the
     // scene, without duplicates. The one-shot's area-weighted mean error is
-    // the lower one (street 4.3 vs 6.3 mm, crossing 4.2 vs 4.7 mm): it fits each
+    // the lower one (street 4.4 vs 6.3 mm, crossing 4.1 vs 4.7 mm): it fits each
     // surface to the whole drive at once, and leaves out most of the
     // vehicle faces. So the mean is not compared here; BENCHMARKS.md gives
     // both. Since its ground clustering tolerance grows with range (session
-    // 8), the one-shot also covers more than the scenario (crossing 0.786
-    // vs 0.733, street 0.831 vs 0.783): it sees the far road
+    // 8), the one-shot also covers more than the scenario (crossing 0.800
+    // vs 0.733, street 0.800 vs 0.783): it sees the far road
     // rings of all 100 scans at once, the scenario each scan's alone. The
     // scenario must cover at least nine tenths of what it covers.
     assert!(
