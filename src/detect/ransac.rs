@@ -747,15 +747,21 @@ mod tests {
             let (x, y) = ((i % 80) as f32 * 0.125, (i / 80) as f32 * 0.125);
             pts.push(Vec3::new(x, y, 0.0));
         }
-        for _ in 0..4000 {
-            let p = Vec3::new(
-                rng.range(0.0, 10.0) as f32,
-                rng.range(0.0, 10.0) as f32,
-                rng.range(0.0, 10.0) as f32,
-            );
-            pts.push(p);
-        }
+        pts.extend(scattered(&mut rng, 4000));
         PlanePool::new(&pts, 1.0, None, Rng::new(9))
+    }
+
+    /// `n` points scattered uniformly through the cube [0, 10 m]^3.
+    fn scattered(rng: &mut Rng, n: usize) -> Vec<Vec3> {
+        (0..n)
+            .map(|_| {
+                Vec3::new(
+                    rng.range(0.0, 10.0) as f32,
+                    rng.range(0.0, 10.0) as f32,
+                    rng.range(0.0, 10.0) as f32,
+                )
+            })
+            .collect()
     }
 
     /// Hypotheses drawn from a thin band of a wall (4 m long, 0.2 m high,
@@ -811,16 +817,7 @@ mod tests {
     /// `max_hypotheses` with slivers redrawn, twice that without.
     #[test]
     fn a_round_scores_at_most_its_hypothesis_budget() {
-        let mut rng = Rng::new(6);
-        let pts: Vec<Vec3> = (0..20_000)
-            .map(|_| {
-                Vec3::new(
-                    rng.range(0.0, 10.0) as f32,
-                    rng.range(0.0, 10.0) as f32,
-                    rng.range(0.0, 10.0) as f32,
-                )
-            })
-            .collect();
+        let pts = scattered(&mut Rng::new(6), 20_000);
         let params = Params {
             min_inliers: 3,
             ..Params::gpp2()
