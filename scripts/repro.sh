@@ -22,6 +22,9 @@ export PATH="$HOME/.cargo/bin:$PATH"
 OUT=${REPRO_OUT:-target/repro}
 REP_SIM=${REPRO_REPEAT_SIM:-3}
 REP_REAL=${REPRO_REPEAT_REAL:-5}
+# pcl.js on the real scans runs as often as polyscene (~1-2 s a run), in the
+# same rounds, so that both medians come from the same stretch of time.
+PCLJS_REP_REAL=${REPRO_PCLJS_REPEAT_REAL:-$REP_REAL}
 SCANS=${REPRO_SCANS:-200}
 DATA=${REPRO_DATA:-$ROOT/www/data}
 CLOUDS=$OUT/clouds
@@ -71,7 +74,7 @@ step "timing (native): gpp1, gpp2, gpp2 convex; $REP_SIM runs per location, $REP
   --variants gpp1,gpp2,gpp2-convex 2>&1 | tee "$LOGS/native.log" || die "native detection failed"
 
 step "timing (one Node process): polyscene wasm (pkg/node) and pcl.js RANSAC x15"
-node_args=("$CLOUDS" "$RES" --repeat-sim "$REP_SIM" --repeat-real "$REP_REAL" --pcljs-repeat-sim 1 --pcljs-repeat-real 3)
+node_args=("$CLOUDS" "$RES" --repeat-sim "$REP_SIM" --repeat-real "$REP_REAL" --pcljs-repeat-sim 1 --pcljs-repeat-real "$PCLJS_REP_REAL")
 [ "$WASM" = 1 ] || node_args+=(--no-wasm)
 if [ "${REPRO_NO_PEERS:-0}" = 1 ] || [[ ",${SKIP_PEERS:-}," == *",pcljs,"* ]]; then node_args+=(--no-pcljs); fi
 node benches/repro/wasm_peers.cjs "${node_args[@]}" 2>&1 | tee "$LOGS/node.log" ||
@@ -120,6 +123,7 @@ step "report: REPRODUCTION.md and docs/repro/"
   echo "date=$(date -u +%Y-%m-%d)"
   echo "rep_sim=$REP_SIM"
   echo "rep_real=$REP_REAL"
+  echo "pcljs_rep_real=$PCLJS_REP_REAL"
   echo "scans=$SCANS"
 } >"$RES/env.txt"
 "$PYR" benches/repro/report.py render "$CLOUDS" "$RES" REPRODUCTION.md docs/repro || die "report failed"

@@ -316,6 +316,7 @@ def render(clouds, res, md_path, figdir):
     sims = [c for c in SIM if c in cinfo]
     reals = [c for c in REAL if c in cinfo]
     rep_sim, rep_real = env.get("rep_sim", "3"), env.get("rep_real", "5")
+    pcl_rep_real = env.get("pcljs_rep_real", "3")
     wasm_ok = node.get("wasm", {}).get("available")
     pcl_ok = node.get("pcljs", {}).get("available")
     o3d_v = peers.get("open3d")
@@ -352,7 +353,7 @@ def render(clouds, res, md_path, figdir):
       f"{int(env.get('seconds', '0')) // 60} min {int(env.get('seconds', '0')) % 60} s wall time on {env.get('date', '?')}. "
       f"Fast methods: median of {rep_sim} runs per simulated location and {rep_real} per real scan, "
       "runs of the methods interleaved (round-robin) so that load spikes of the shared machine hit every method alike; "
-      "slow peers (meshing, Open3D RANSAC + DBSCAN) and pcl.js on the locations: 1 run; pcl.js on the real scans: 3 runs; "
+      f"slow peers (meshing, Open3D RANSAC + DBSCAN) and pcl.js on the locations: 1 run; pcl.js on the real scans: {pcl_rep_real} runs; "
       "detect_planar_patches on the real scans: 3 runs.")
     A("")
     summary_at = len(L)
@@ -435,7 +436,7 @@ def render(clouds, res, md_path, figdir):
     rows.append(["input points"] + [f"{cinfo[c]['points'] / 1e6:.2f} M" for c in clouds_present] + ["1.3 M"])
     A(table(hdr, rows))
     A(prov(f"median of {rep_sim} (locations) / {rep_real} (real scans) interleaved runs for polyscene native and wasm; "
-           "pcl.js 1 run per location, 3 per real scan; Open3D/PCL 1 run (planar patches: 3 on the real scans)"))
+           f"pcl.js 1 run per location, {pcl_rep_real} per real scan; Open3D/PCL 1 run (planar patches: 3 on the real scans)"))
     A("")
     small = [peerby[(c, "bpa")]["inputPoints"] for c in sims if peerby.get((c, "bpa"), {}).get("inputPoints")]
     small_txt = ", ".join(f"{n:,}" for n in small) if small else "?"
@@ -504,7 +505,7 @@ def render(clouds, res, md_path, figdir):
                                   f"{p['medianSegMs'] / sd['medianMs']:.1f}x"])
         A(table(["cloud", "points", "gpp2 wasm (s)", "pcl.js segment() (s)", "pcl.js loop (s)",
                  "speed-up vs segment()", "vs whole loop", "≥ 40x?"], rows))
-        A(prov(f"one Node process, runs interleaved; gpp2 median of {rep_sim}/{rep_real} runs, pcl.js median of 1/3 runs"))
+        A(prov(f"one Node process, runs interleaved; gpp2 median of {rep_sim}/{rep_real} runs, pcl.js median of 1/{pcl_rep_real} runs"))
         A("")
         if seed_rows:
             A("The rows above use the default RANSAC seed, as a user gets it. How long the cascade runs (how many "
