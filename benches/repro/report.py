@@ -515,6 +515,10 @@ def render(clouds, res, md_path, figdir):
                      "default seed (s)", "speed-up vs segment() at the median"], seed_rows))
             A(prov("one Node process, after the runs above; one run per seed"))
             A("")
+            A("pcl.js is not run again here: the last column divides its median from the runs above by these later "
+              "runs, so it is only as good as the machine's load was steady in between. The default-seed rows above, "
+              "run in the same rounds, are the like-for-like comparison.")
+            A("")
         A("pcl.js: `SACSegmentation` (plane, `SAC_RANSAC`, 0.10 m — the gpp2 inlier distance —, 1000 iterations, "
           "coefficients optimised) on the remaining points, 15 times, each plane's inliers removed. "
           "pcl.js has no `ExtractIndices`, so the loop rebuilds the remaining cloud from JS; the conservative ratio "
