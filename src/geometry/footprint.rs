@@ -389,11 +389,12 @@ impl Footprint {
     /// bridged: from each set cell farther than `range` from `foot`, walk
     /// towards `foot`; when a set cell lies within the clustering's reach
     /// (back along the line of sight to where the distance after pulling,
-    /// `geometry::pull_range`, is `tol` less), set the cells in between. Only gaps with set cells on both sides are filled,
-    /// never the area in front of the nearest points, and only those at
-    /// least `narrowest` wide (an outline's closing fills the narrower
-    /// ones). Each walk is at most [`MAX_TRAIL`] cells; the walks read the
-    /// cells as they were before. Returns how many cells were newly set.
+    /// `geometry::pull_range`, is `tol` less), set the cells in between.
+    /// Only gaps with set cells on both sides are filled, never the area in
+    /// front of the nearest points, and only those at least `narrowest`
+    /// wide (an outline's closing fills the narrower ones). Each walk is at
+    /// most [`MAX_TRAIL`] cells; the walks read the cells as they were
+    /// before. Returns how many cells were newly set.
     // Not inlined: it runs once per ground candidate of one-shot detection,
     // and its code stays out of the shape step it is called from.
     #[inline(never)]
