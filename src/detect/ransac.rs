@@ -125,7 +125,7 @@ pub struct PlanePool {
     /// Positions of the points within [`NEAR_VIEWPOINT`] of the viewpoint,
     /// when planes seen edge-on are no hypotheses (see
     /// [`PlanePool::seen_edge_on`]).
-    near: Option<Vec<u32>>,
+    near: Option<Near>,
     /// Smallest height of a sample triangle on its longest side, relative
     /// to that side (0: any triple not near-collinear; see
     /// [`PlanePool::reject_slivers`]).
@@ -225,7 +225,17 @@ impl PlanePool {
             // sensor, and keeps each look bounded (a sensor close to
             // surfaces has many points near it).
             let step = near.len().div_ceil(NEAR_CAP).max(1);
-            near.into_iter().step_by(step).collect()
+            let positions: Vec<u32> = near.into_iter().step_by(step).collect();
+            let coords = |k: usize| -> Vec<f32> {
+                positions.iter().map(|&v| cell_pts[v as usize][k]).collect()
+            };
+            Near {
+                xs: coords(0),
+                ys: coords(1),
+                zs: coords(2),
+                positions,
+                hits: Vec::new(),
+            }
         });
         let mut pool = PlanePool {
             pool_live: 0,
@@ -488,23 +498,28 @@ impl PlanePool {
     /// belong to. The sensor stands on the plane when [`NEAR_SUPPORT`] of its
     /// live inliers lie within [`NEAR_VIEWPOINT`] of the viewpoint: a floor
     /// under a low sensor is a plane like any other.
-    fn seen_edge_on(&self, plane: &LocalPlane, viewpoint: DVec3, params: &Params) -> bool {
-        let Some(near) = &self.near else {
+    fn seen_edge_on(&mut self, plane: &LocalPlane, viewpoint: DVec3, params: &Params) -> bool {
+        let Some(near) = &mut self.near else {
             return false;
         };
         if !super::through_viewpoint(plane.normal.dot(viewpoint) + plane.offset, params) {
             return false;
         }
-        let (n, d, t) = (
-            plane.normal.as_vec3(),
-            plane.offset as f32,
+        // The near points on the plane (the vector kernel, the same test
+        // as everywhere), then how many of them are still in play.
+        near.hits.clear();
+        let pts = kernels::Points::new(&near.xs, &near.ys, &near.zs);
+        kernels::inliers(
+            pts,
+            plane.as_f32(),
             plane.threshold as f32,
+            0,
+            &mut near.hits,
         );
         let on = near
+            .hits
             .iter()
-            .filter(|&&v| {
-                self.alive[v as usize] && (n.dot(self.cell_pts[v as usize]) + d).abs() < t
-            })
+            .filter(|&&k| self.alive[near.positions[k as usize] as usize])
             .take(NEAR_SUPPORT)
             .count();
         on < NEAR_SUPPORT
@@ -707,6 +722,17 @@ impl PlanePool {
         let fit = robust_fit(&pts, *pts.first()?)?;
         Some((fit.plane.normal, fit.plane.offset))
     }
+}
+
+/// The points within [`NEAR_VIEWPOINT`] of the viewpoint (at most
+/// [`NEAR_CAP`]): their positions and coordinates, one array per axis.
+struct Near {
+    positions: Vec<u32>,
+    xs: Vec<f32>,
+    ys: Vec<f32>,
+    zs: Vec<f32>,
+    /// Scratch: indices of those on a plane.
+    hits: Vec<u32>,
 }
 
 /// Keep a uniform random subset of at most `m` of `order`, in random order
