@@ -372,6 +372,80 @@ pub fn ring_distance(a: &[DVec2], b: &[DVec2]) -> f64 {
     best.sqrt()
 }
 
+/// `ring_distance(a, b) <= gap`, the same answer for every input, found
+/// with less work: edge pairs whose boxes lie farther apart than `gap`
+/// are skipped (they can neither cross nor come within `gap`), and the
+/// search stops at the first pair within `gap`.
+pub fn rings_within(a: &[DVec2], b: &[DVec2], gap: f64) -> bool {
+    if a.len() < 3 || b.len() < 3 || gap.is_nan() {
+        return f64::INFINITY <= gap;
+    }
+    if contains(a, b[0]) || contains(b, a[0]) {
+        return 0.0 <= gap;
+    }
+    // For finite `gap >= 0`, sqrt(gap * gap) is `gap` exactly, so a pair
+    // with squared distance at most `gap * gap` settles it; boxes are
+    // compared with a relative margin far above rounding.
+    let gap2 = gap * gap;
+    let pad = gap * (1.0 + 1e-9) + 1e-12;
+    let boxes: Vec<(DVec2, DVec2)> = (0..b.len())
+        .map(|j| {
+            let (r, s) = (b[j], b[(j + 1) % b.len()]);
+            (
+                DVec2::new(min2(r.x, s.x), min2(r.y, s.y)),
+                DVec2::new(max2(r.x, s.x), max2(r.y, s.y)),
+            )
+        })
+        .collect();
+    let mut best = f64::INFINITY;
+    for i in 0..a.len() {
+        let (p, q) = (a[i], a[(i + 1) % a.len()]);
+        let lo = DVec2::new(min2(p.x, q.x) - pad, min2(p.y, q.y) - pad);
+        let hi = DVec2::new(max2(p.x, q.x) + pad, max2(p.y, q.y) + pad);
+        for (j, &(blo, bhi)) in boxes.iter().enumerate() {
+            if blo.x > hi.x || blo.y > hi.y || bhi.x < lo.x || bhi.y < lo.y {
+                continue;
+            }
+            let (r, s) = (b[j], b[(j + 1) % b.len()]);
+            if segments_intersect(p, q, r, s) {
+                return 0.0 <= gap;
+            }
+            for d in [
+                segment_distance_sq(p, r, s),
+                segment_distance_sq(q, r, s),
+                segment_distance_sq(r, p, q),
+                segment_distance_sq(s, p, q),
+            ] {
+                best = if d < best { d } else { best };
+            }
+            if best <= gap2 && gap >= 0.0 {
+                return true;
+            }
+        }
+    }
+    best.sqrt() <= gap
+}
+
+/// `min` by comparison (`f64::min` is a library call in wasm).
+#[inline]
+fn min2(a: f64, b: f64) -> f64 {
+    if b < a {
+        b
+    } else {
+        a
+    }
+}
+
+/// `max` by comparison.
+#[inline]
+fn max2(a: f64, b: f64) -> f64 {
+    if b > a {
+        b
+    } else {
+        a
+    }
+}
+
 /// A planar polygon in 3D: a frame on its plane and a simple counter-clockwise
 /// ring in that frame's 2D coordinates (so it is counter-clockwise seen from
 /// the normal side).
@@ -625,5 +699,38 @@ mod tests {
         for (a, b) in p.vertices().iter().zip(&verts) {
             assert!((*a - *b).length() < 1e-9);
         }
+    }
+
+    /// The quick predicate answers as the full distance does: random star
+    /// rings near each other (apart, touching, crossing, nested), over
+    /// gaps from 0 to beyond their distance, and exactly at it.
+    #[test]
+    fn rings_within_is_ring_distance_below_the_gap() {
+        let mut rng = crate::rng::Rng::new(11);
+        let star = |rng: &mut crate::rng::Rng, c: DVec2| -> Vec<DVec2> {
+            let k = 3 + rng.below(30);
+            (0..k)
+                .map(|i| {
+                    let a = std::f64::consts::TAU * i as f64 / k as f64;
+                    let r = rng.range(0.3, 2.0);
+                    c + DVec2::new(libm::cos(a), libm::sin(a)) * r
+                })
+                .collect()
+        };
+        let (mut near, mut apart) = (0, 0);
+        for _ in 0..2000 {
+            let a = star(&mut rng, DVec2::ZERO);
+            let c = DVec2::new(rng.range(-5.0, 5.0), rng.range(-5.0, 5.0));
+            let b = star(&mut rng, c);
+            let d = ring_distance(&a, &b);
+            for gap in [0.0, 0.1, 0.3, 1.0, 3.0, d, d * 0.999, d * 1.001] {
+                let within = rings_within(&a, &b, gap);
+                assert_eq!(within, d <= gap, "d {d} gap {gap}");
+                near += within as usize;
+                apart += !within as usize;
+            }
+        }
+        assert!(near > 1000 && apart > 1000, "{near} {apart}");
+        assert!(!rings_within(&[DVec2::ZERO], &[DVec2::ONE; 3], 100.0));
     }
 }

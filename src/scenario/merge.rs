@@ -3,7 +3,7 @@
 //! once they are near-coplanar and their outlines touch or overlap. The
 //! older id survives.
 
-use crate::geometry::polygon::ring_distance;
+use crate::geometry::polygon::rings_within;
 use crate::params::{HullKind, Params};
 use crate::primitive::Primitive;
 use glam::{DVec2, DVec3};
@@ -29,8 +29,12 @@ pub(crate) fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
     // moves the plane by centimetres, and would let a sidewalk (one curb
     // higher) merge in; a maximum would keep a slightly tilted piece apart
     // forever.
-    let (big, small) = if a.area >= b.area { (a, b) } else { (b, a) };
-    let mut pts = small.vertices();
+    let (av, bv) = (a.vertices(), b.vertices());
+    let (big, small, mut pts) = if a.area >= b.area {
+        (a, b, bv.clone())
+    } else {
+        (b, a, av.clone())
+    };
     pts.push(small.moments.mean());
     let ms = pts
         .iter()
@@ -48,15 +52,14 @@ pub(crate) fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
     if ms.sqrt() > params.merge_distance && !centroids {
         return false;
     }
-    let (alo, ahi) = bounds(&a.vertices());
-    let (blo, bhi) = (bounds(&b.vertices()).0, bounds(&b.vertices()).1);
+    let ((alo, ahi), (blo, bhi)) = (bounds(&av), bounds(&bv));
     let pad = DVec3::splat(params.merge_gap + params.merge_distance);
     if (alo - pad).cmpgt(bhi).any() || (blo - pad).cmpgt(ahi).any() {
         return false;
     }
     // The outlines, both in a's frame: touching or overlapping?
-    let b_in_a: Vec<DVec2> = b.vertices().iter().map(|&v| a.frame.to_local(v)).collect();
-    ring_distance(&a.outline, &b_in_a) <= params.merge_gap
+    let b_in_a: Vec<DVec2> = bv.iter().map(|&v| a.frame.to_local(v)).collect();
+    rings_within(&a.outline, &b_in_a, params.merge_gap)
 }
 
 /// Absorb `b` into `a`.
