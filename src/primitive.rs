@@ -142,7 +142,7 @@ pub fn min_width(ring: &[DVec2]) -> f64 {
     let mut best = f64::INFINITY;
     for i in 0..n {
         let (a, b) = (h[i], h[(i + 1) % n]);
-        let e = (b - a).normalize_or_zero();
+        let e = crate::geometry::unit_or_zero(b - a);
         let w = h.iter().map(|&p| e.perp_dot(p - a)).fold(0.0f64, f64::max);
         best = best.min(w);
     }

@@ -493,9 +493,9 @@ impl Footprint {
             let ox = (self.x0 + lx as i64) as f64 * self.cell - m as f64 * cs;
             let oy = (self.y0 + ly as i64) as f64 * self.cell - m as f64 * cs;
             let region = Region {
-                cell: self.cell,
+                inv: 1.0 / self.cell,
                 base: (self.x0 + lx as i64, self.y0 + ly as i64),
-                factor: factor as i64,
+                shift: factor.trailing_zeros(),
                 margin: m as i64,
                 w: gw,
                 h: gh,
@@ -538,9 +538,11 @@ impl Footprint {
 /// this region's boundary.
 #[derive(Clone, Debug)]
 pub struct Region {
-    cell: f64,
+    /// Inverse of the footprint's cell side.
+    inv: f64,
     base: (i64, i64),
-    factor: i64,
+    /// Footprint cells per region cell: `1 << shift` (a power of two).
+    shift: u32,
     margin: i64,
     w: usize,
     h: usize,
@@ -561,9 +563,10 @@ impl Region {
     /// Does the footprint cell under `p` belong to the region? Uses the
     /// footprint's own cell indexing, so it agrees exactly with `mark_all`.
     pub fn contains(&self, p: DVec2) -> bool {
-        let (ix, iy) = cell_index(p, 1.0 / self.cell);
-        let x = (ix - self.base.0).div_euclid(self.factor) + self.margin;
-        let y = (iy - self.base.1).div_euclid(self.factor) + self.margin;
+        let (ix, iy) = cell_index(p, self.inv);
+        // An arithmetic shift is floor division by the power of two.
+        let x = ((ix - self.base.0) >> self.shift) + self.margin;
+        let y = ((iy - self.base.1) >> self.shift) + self.margin;
         x >= 0
             && y >= 0
             && (x as usize) < self.w
@@ -582,8 +585,8 @@ fn inset_rectilinear(ring: &[DVec2], d: f64) -> Vec<DVec2> {
             let prev = ring[(i + n - 1) % n];
             let cur = ring[i];
             let next = ring[(i + 1) % n];
-            let a = left((cur - prev).normalize_or_zero());
-            let b = left((next - cur).normalize_or_zero());
+            let a = left(super::unit_or_zero(cur - prev));
+            let b = left(super::unit_or_zero(next - cur));
             cur + (a + b) * d
         })
         .collect()

@@ -13,6 +13,18 @@ pub use hull::convex_hull;
 pub use plane::{Frame, Moments, Plane, UP};
 pub use polygon::Polygon3;
 
+/// `v.normalize_or_zero()` with the sqrt instruction: glam's (with its
+/// `libm` feature) calls a software square root in wasm. Both are correctly
+/// rounded, so the bits are the same.
+pub(crate) fn unit_or_zero(v: glam::DVec2) -> glam::DVec2 {
+    let rcp = 1.0 / v.length_squared().sqrt();
+    if rcp.is_finite() && rcp > 0.0 {
+        v * rcp
+    } else {
+        glam::DVec2::ZERO
+    }
+}
+
 /// The ground's range pulling (one-shot detection): a distance `r` from the
 /// viewpoint's foot beyond `range` becomes `2 range - range^2 / r`
 /// (continuous and increasing, below `2 range`); nearer ones stay. Points

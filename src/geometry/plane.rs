@@ -543,7 +543,11 @@ mod tests {
             let n = DVec3::new(rng.gaussian(), rng.gaussian(), rng.gaussian()).normalize();
             let f = Frame::on_plane(&Plane::from_point_normal(DVec3::ZERO, n), DVec3::ZERO);
             let (a, b) = (rng.range(0.1, 2.0), rng.range(0.1, 2.0));
-            let c = if case % 3 == 0 { 1e-3 } else { rng.range(0.0, 2.0) };
+            let c = if case % 3 == 0 {
+                1e-3
+            } else {
+                rng.range(0.0, 2.0)
+            };
             let mut m = Moments::new(DVec3::new(3.0, -1.0, 2.0));
             for _ in 0..50 {
                 let q = DVec2::new(a * rng.gaussian(), b * rng.gaussian());
@@ -553,12 +557,18 @@ mod tests {
             let (vals, vecs) = symmetric_eigen3(cov);
             let (cvals, normal) = smallest_eigen3(cov).unwrap();
             for k in 0..3 {
-                assert!((vals[k] - cvals[k]).abs() <= 1e-9 * vals[2], "{vals:?} {cvals:?}");
+                assert!(
+                    (vals[k] - cvals[k]).abs() <= 1e-9 * vals[2],
+                    "{vals:?} {cvals:?}"
+                );
             }
             assert!((normal.length() - 1.0).abs() < 1e-12);
             // The vector is as good as the gap to the next eigenvalue allows.
             let gap = (vals[1] - vals[0]) / vals[2];
-            assert!(normal.dot(vecs[0]).abs() > 1.0 - 1e-9 / (gap * gap), "gap {gap}");
+            assert!(
+                normal.dot(vecs[0]).abs() > 1.0 - 1e-9 / (gap * gap),
+                "gap {gap}"
+            );
         }
         let mut eye = [[0.0; 3]; 3];
         for (k, row) in eye.iter_mut().enumerate() {
