@@ -110,8 +110,9 @@ pub struct PlanePool {
     cell_pts: Vec<Vec3>,
     /// Position of each original index.
     cell_pos_of: Vec<u32>,
-    /// Bounding box of each voxel's points (centre, half extent), f64.
-    cell_box: Vec<(DVec3, DVec3)>,
+    /// Bounding box of each voxel's points (centre, half extent), f64, and
+    /// the rounding margin of its inlier test (see [`PlanePool::collect`]).
+    cell_box: Vec<(DVec3, DVec3, f64)>,
     /// Live points per voxel.
     cell_live: Vec<u32>,
     rng: Rng,
@@ -204,14 +205,15 @@ impl PlanePool {
             for p in members {
                 crate::geometry::grow_box(&mut lo, &mut hi, p.as_dvec3());
             }
-            cell_box.push(((lo + hi) * 0.5, (hi - lo) * 0.5));
+            let centre = (lo + hi) * 0.5;
+            cell_box.push((centre, (hi - lo) * 0.5, 1e-6 * centre.abs().max_element()));
             cell_live.push(members.len() as u32);
         }
         // The points near the viewpoint, found through the voxels' boxes.
         let near = edge_on.map(|viewpoint| {
             let r2 = NEAR_VIEWPOINT * NEAR_VIEWPOINT;
             let mut near = Vec::new();
-            for (c, &(centre, half)) in cell_box.iter().enumerate() {
+            for (c, &(centre, half, _)) in cell_box.iter().enumerate() {
                 let gap = ((centre - viewpoint).abs() - half).max(DVec3::ZERO);
                 if gap.length_squared() <= r2 {
                     for pos in buckets.range(c) {
@@ -596,11 +598,13 @@ impl PlanePool {
         if len.is_nan() || len <= 1e-4 {
             return None;
         }
-        // `len` is the height on the longest side times that side.
-        let longest = (p2 - p1)
-            .length_squared()
-            .max((p3 - p1).length_squared())
-            .max((p3 - p2).length_squared());
+        // `len` is the height on the longest side times that side. The
+        // points are finite here (`len` is not NaN): `max` by comparison
+        // (`f64::max` is a library call in wasm).
+        let mut longest = (p2 - p1).length_squared();
+        for side in [(p3 - p1).length_squared(), (p3 - p2).length_squared()] {
+            longest = if side > longest { side } else { longest };
+        }
         if len < self.min_fatness * longest {
             return None;
         }
@@ -673,14 +677,16 @@ impl PlanePool {
         let (d, t) = (plane.offset as f32, plane.threshold as f32);
         let an = plane.normal.abs();
         let (mut out, mut coords) = (Vec::new(), Vec::new());
-        for (c, &(centre, half)) in self.cell_box.iter().enumerate() {
+        for (c, &(centre, half, slack)) in self.cell_box.iter().enumerate() {
             if self.cell_live[c] == 0 {
                 continue;
             }
             self.work += 1;
             // Distance from the centre, less the box's reach along the
-            // normal, with a margin for the f32 point test below.
-            let reach = an.dot(half) + plane.threshold + 1e-3 + 1e-6 * centre.abs().max_element();
+            // normal, with a margin for the f32 point test below (a
+            // millionth of the centre's largest coordinate, kept per voxel:
+            // `max` is a library call in wasm).
+            let reach = an.dot(half) + plane.threshold + 1e-3 + slack;
             if (plane.normal.dot(centre) + plane.offset).abs() > reach {
                 continue;
             }
