@@ -123,9 +123,8 @@ pub struct PlanePool {
     pool_live: usize,
     /// Pool position of each position (`u32::MAX` when not in the pool).
     pos_of: Vec<u32>,
-    /// Positions of the points within [`NEAR_VIEWPOINT`] of the viewpoint,
-    /// when planes seen edge-on are no hypotheses (see
-    /// [`PlanePool::seen_edge_on`]).
+    /// The points within [`NEAR_VIEWPOINT`] of the viewpoint, when planes
+    /// seen edge-on are no hypotheses (see [`PlanePool::seen_edge_on`]).
     near: Option<Near>,
     /// Smallest height of a sample triangle on its longest side, relative
     /// to that side (0: any triple not near-collinear; see
