@@ -348,28 +348,7 @@ fn dp_closed(ring: &[DVec2], tol: f64) -> Vec<DVec2> {
 /// Smallest distance between the boundaries of two rings, or 0 when they
 /// overlap (one contains a vertex of the other, or edges cross).
 pub fn ring_distance(a: &[DVec2], b: &[DVec2]) -> f64 {
-    if a.len() < 3 || b.len() < 3 {
-        return f64::INFINITY;
-    }
-    if contains(a, b[0]) || contains(b, a[0]) {
-        return 0.0;
-    }
-    let mut best = f64::INFINITY;
-    for i in 0..a.len() {
-        let (p, q) = (a[i], a[(i + 1) % a.len()]);
-        for j in 0..b.len() {
-            let (r, s) = (b[j], b[(j + 1) % b.len()]);
-            if segments_intersect(p, q, r, s) {
-                return 0.0;
-            }
-            best = best
-                .min(segment_distance_sq(p, r, s))
-                .min(segment_distance_sq(q, r, s))
-                .min(segment_distance_sq(r, p, q))
-                .min(segment_distance_sq(s, p, q));
-        }
-    }
-    best.sqrt()
+    closest_sq(a, b, f64::INFINITY, -1.0).sqrt()
 }
 
 /// `ring_distance(a, b) <= gap`, the same answer for every input, found
@@ -377,38 +356,43 @@ pub fn ring_distance(a: &[DVec2], b: &[DVec2]) -> f64 {
 /// are skipped (they can neither cross nor come within `gap`), and the
 /// search stops at the first pair within `gap`.
 pub fn rings_within(a: &[DVec2], b: &[DVec2], gap: f64) -> bool {
-    if a.len() < 3 || b.len() < 3 || gap.is_nan() {
-        return f64::INFINITY <= gap;
+    // For finite `gap >= 0`, sqrt(gap * gap) is `gap` exactly, so the
+    // search may stop at a squared distance of `gap * gap`; boxes are
+    // compared with a relative margin far above rounding.
+    closest_sq(a, b, gap * (1.0 + 1e-9) + 1e-12, gap * gap).sqrt() <= gap
+}
+
+/// Smallest squared distance between the boundaries of two rings (0 when
+/// they overlap, infinite for a ring of under three vertices). Edge pairs
+/// whose boxes lie more than `skip` apart are passed over, and the search
+/// ends at the first squared distance of at most `enough`.
+fn closest_sq(a: &[DVec2], b: &[DVec2], skip: f64, enough: f64) -> f64 {
+    if a.len() < 3 || b.len() < 3 {
+        return f64::INFINITY;
     }
     if contains(a, b[0]) || contains(b, a[0]) {
-        return 0.0 <= gap;
+        return 0.0;
     }
-    // For finite `gap >= 0`, sqrt(gap * gap) is `gap` exactly, so a pair
-    // with squared distance at most `gap * gap` settles it; boxes are
-    // compared with a relative margin far above rounding.
-    let gap2 = gap * gap;
-    let pad = gap * (1.0 + 1e-9) + 1e-12;
+    let edge_box = |r: DVec2, s: DVec2| {
+        let (mut lo, mut hi) = (r, r);
+        super::grow_box(&mut lo, &mut hi, s);
+        (lo, hi)
+    };
     let boxes: Vec<(DVec2, DVec2)> = (0..b.len())
-        .map(|j| {
-            let (r, s) = (b[j], b[(j + 1) % b.len()]);
-            (
-                DVec2::new(min2(r.x, s.x), min2(r.y, s.y)),
-                DVec2::new(max2(r.x, s.x), max2(r.y, s.y)),
-            )
-        })
+        .map(|j| edge_box(b[j], b[(j + 1) % b.len()]))
         .collect();
     let mut best = f64::INFINITY;
     for i in 0..a.len() {
         let (p, q) = (a[i], a[(i + 1) % a.len()]);
-        let lo = DVec2::new(min2(p.x, q.x) - pad, min2(p.y, q.y) - pad);
-        let hi = DVec2::new(max2(p.x, q.x) + pad, max2(p.y, q.y) + pad);
+        let (lo, hi) = edge_box(p, q);
+        let (lo, hi) = (lo - DVec2::splat(skip), hi + DVec2::splat(skip));
         for (j, &(blo, bhi)) in boxes.iter().enumerate() {
             if blo.x > hi.x || blo.y > hi.y || bhi.x < lo.x || bhi.y < lo.y {
                 continue;
             }
             let (r, s) = (b[j], b[(j + 1) % b.len()]);
             if segments_intersect(p, q, r, s) {
-                return 0.0 <= gap;
+                return 0.0;
             }
             for d in [
                 segment_distance_sq(p, r, s),
@@ -418,32 +402,12 @@ pub fn rings_within(a: &[DVec2], b: &[DVec2], gap: f64) -> bool {
             ] {
                 best = if d < best { d } else { best };
             }
-            if best <= gap2 && gap >= 0.0 {
-                return true;
+            if best <= enough {
+                return best;
             }
         }
     }
-    best.sqrt() <= gap
-}
-
-/// `min` by comparison (`f64::min` is a library call in wasm).
-#[inline]
-fn min2(a: f64, b: f64) -> f64 {
-    if b < a {
-        b
-    } else {
-        a
-    }
-}
-
-/// `max` by comparison.
-#[inline]
-fn max2(a: f64, b: f64) -> f64 {
-    if b > a {
-        b
-    } else {
-        a
-    }
+    best
 }
 
 /// A planar polygon in 3D: a frame on its plane and a simple counter-clockwise

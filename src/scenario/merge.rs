@@ -30,20 +30,21 @@ pub(crate) fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
     // higher) merge in; a maximum would keep a slightly tilted piece apart
     // forever.
     let (av, bv) = (a.vertices(), b.vertices());
-    let (big, small, mut pts) = if a.area >= b.area {
-        (a, b, bv.clone())
+    let (big, small, small_v) = if a.area >= b.area {
+        (a, b, &bv)
     } else {
-        (b, a, av.clone())
+        (b, a, &av)
     };
-    pts.push(small.moments.mean());
-    let ms = pts
+    let ms = small_v
         .iter()
-        .map(|&p| {
+        .copied()
+        .chain([small.moments.mean()])
+        .map(|p| {
             let d = big.plane.signed_distance(p);
             d * d
         })
         .sum::<f64>()
-        / pts.len() as f64;
+        / (small_v.len() + 1) as f64;
     // Or each centroid on the other's plane (two slightly tilted pieces of
     // one surface whose far vertices disagree).
     let (ca, cb) = (a.moments.mean(), b.moments.mean());
