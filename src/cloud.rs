@@ -129,7 +129,7 @@ fn bbox_centre(points: impl Iterator<Item = DVec3>) -> DVec3 {
     let mut hi = DVec3::splat(f64::NEG_INFINITY);
     let mut any = false;
     for p in points {
-        // By selects: `f64::min`/`max` are library calls in wasm (the
+        // By selects: `f64::min`/`max` also test for NaN in wasm (the
         // points are finite here, so the results are the same).
         crate::geometry::grow_box(&mut lo, &mut hi, p);
         any = true;

@@ -454,8 +454,8 @@ pub fn voxelise(pts: &[glam::Vec3], voxel: f64) -> Voxels {
     );
     let mut finite = true;
     for p in pts {
-        // f32 comparisons per lane as selects (f32::min/max are library
-        // calls in wasm; branches mispredict while the box grows).
+        // f32 comparisons per lane as selects (f32::min/max also test for
+        // NaN in wasm; branches mispredict while the box grows).
         for k in 0..3 {
             plo[k] = if p[k] < plo[k] { p[k] } else { plo[k] };
             phi[k] = if p[k] > phi[k] { p[k] } else { phi[k] };

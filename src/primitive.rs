@@ -143,8 +143,8 @@ pub fn min_width(ring: &[DVec2]) -> f64 {
     for i in 0..n {
         let (a, b) = (h[i], h[(i + 1) % n]);
         let e = crate::geometry::unit_or_zero(b - a);
-        // Comparisons, not `f64::max`/`min` (library calls in wasm): the
-        // same result (a NaN would be skipped by both).
+        // Comparisons, not `f64::max`/`min` (which also test for NaN in
+        // wasm): the same result (a NaN would be skipped by both).
         let mut w = 0.0f64;
         for &p in &h {
             let d = e.perp_dot(p - a);

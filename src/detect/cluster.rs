@@ -233,7 +233,7 @@ impl Clusterer {
     }
 }
 
-/// `max(a, b, 0)` by comparisons (`f64::max` is a library call in wasm);
+/// `max(a, b, 0)` by comparisons (`f64::max` also tests for NaN in wasm);
 /// the gaps it computes are finite.
 #[inline]
 fn max0(a: f64, b: f64) -> f64 {

@@ -599,7 +599,7 @@ impl PlanePool {
         }
         // `len` is the height on the longest side times that side. The
         // points are finite here (`len` is not NaN): `max` by comparison
-        // (`f64::max` is a library call in wasm).
+        // (`f64::max` also tests for NaN in wasm).
         let mut longest = (p2 - p1).length_squared();
         for side in [(p3 - p1).length_squared(), (p3 - p2).length_squared()] {
             longest = if side > longest { side } else { longest };
@@ -683,8 +683,8 @@ impl PlanePool {
             self.work += 1;
             // Distance from the centre, less the box's reach along the
             // normal, with a margin for the f32 point test below (a
-            // millionth of the centre's largest coordinate, kept per voxel:
-            // `max` is a library call in wasm).
+            // millionth of the centre's largest coordinate, kept per voxel
+            // rather than taken with two `max` per voxel and round).
             let reach = an.dot(half) + plane.threshold + 1e-3 + slack;
             if (plane.normal.dot(centre) + plane.offset).abs() > reach {
                 continue;

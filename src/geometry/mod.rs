@@ -52,8 +52,9 @@ pub(crate) fn unpull_range(q: f64, range: f64) -> f64 {
 }
 
 /// Grow the box `[lo, hi]` to hold `p`, by comparisons written as selects.
-/// (`f64::min` and `max` become library calls in wasm, whose `f64.min`
-/// treats NaN differently; these loops run once per point. As selects they
+/// (wasm's `f64.min` treats NaN differently, so `f64::min` and `max`
+/// become calls to `fmin`/`fmax`, which wasm-opt inlines as a NaN test, a
+/// comparison and two selects; these loops run once per point. As selects they
 /// compile branch-free, to `minsd`/`maxsd` natively: a branch per
 /// coordinate mispredicts often while a box is still growing, which made
 /// the clustering's per-cell boxes cost twice as much. NaN coordinates are
