@@ -18,6 +18,7 @@ pub mod eval;
 pub mod geometry;
 pub mod hash;
 pub mod io;
+mod merge;
 pub mod mesh;
 pub mod params;
 pub mod primitive;

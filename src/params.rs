@@ -26,6 +26,14 @@ pub enum HullKind {
     Concave,
 }
 
+impl HullKind {
+    /// Can one-shot detection merge the pieces of one surface? A convex
+    /// hull of two pieces would cover what lies between them.
+    pub fn merges_pieces(self) -> bool {
+        self == HullKind::Concave
+    }
+}
+
 /// How "solidity", the paper's second acceptance test, is measured.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]

@@ -9,6 +9,9 @@ use crate::params::{HullKind, Params, SolidityKind};
 use glam::{DVec2, DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 
+/// Label of a point that no primitive explains.
+pub const NO_PRIMITIVE: u32 = u32::MAX;
+
 /// One planar polygon of the scenario.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Primitive {

@@ -257,9 +257,11 @@ fn one_plane_holding_several_surfaces_gives_each_in_one_round() {
             .to_local(DVec3::new(k as f64 * 6.0 + side / 2.0, 0.0, 0.9));
         assert!(contains(&q.outline, centre), "{k}");
     }
-    let paper = polyscene::detect::Detector::new(&p)
-        .largest_cluster_only()
-        .run(&cloud.points, cloud.origin, DVec3::from_array(p.viewpoint));
+    let paper = polyscene::detect::Detector::new(
+        &p,
+        polyscene::detect::CascadePolicy::scenario_leftovers(),
+    )
+    .run(&cloud.points, cloud.origin, DVec3::from_array(p.viewpoint));
     assert_eq!(paper.primitives.len(), 5);
     assert!(paper.steps.iter().all(|s| s.accepted <= 1));
     assert!(paper.steps.len() >= 5);

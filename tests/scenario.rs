@@ -4,7 +4,7 @@
 mod common;
 
 use glam::{DMat4, DVec3};
-use polyscene::detect::{Detector, NO_PRIMITIVE};
+use polyscene::detect::{CascadePolicy, Detector, NO_PRIMITIVE};
 use polyscene::eval::{self, EvalOptions, GtSurface};
 use polyscene::geometry::Polygon3;
 use polyscene::params::{HullKind, Params};
@@ -173,7 +173,7 @@ fn drive_through(layout: Layout) {
             ..Params::gpp2()
         };
         let one = if paper {
-            Detector::new(&params).largest_cluster_only().run(
+            Detector::new(&params, CascadePolicy::scenario_leftovers()).run(
                 &cloud.points,
                 cloud.origin,
                 mean_pose,

@@ -130,6 +130,9 @@ pub struct PlanePool {
     /// to that side (0: any triple not near-collinear; see
     /// [`PlanePool::reject_slivers`]).
     min_fatness: f64,
+    /// Hypotheses per round, in units of `max_hypotheses` (see
+    /// [`PlanePool::hypothesis_scale`]).
+    hypothesis_scale: usize,
     /// Point-to-plane distance evaluations so far.
     pub work: u64,
     /// Hypotheses scored so far.
@@ -256,6 +259,7 @@ impl PlanePool {
             rng,
             near,
             min_fatness: 0.0,
+            hypothesis_scale: 1,
             work: 0,
             scored: 0,
         };
@@ -279,16 +283,15 @@ impl PlanePool {
         self
     }
 
-    /// Most hypotheses scored per round: `max_hypotheses` with sliver
-    /// triples redrawn (one-shot detection), twice that with the plain
-    /// sampler (the paper's cascade and the scenario). See
-    /// [`Params::max_hypotheses`] for why.
+    /// Score up to `scale` times `max_hypotheses` per round (default 1).
+    pub fn hypothesis_scale(mut self, scale: usize) -> Self {
+        self.hypothesis_scale = scale;
+        self
+    }
+
+    /// Most hypotheses scored per round.
     fn hypothesis_budget(&self, params: &Params) -> usize {
-        if self.min_fatness > 0.0 {
-            params.max_hypotheses
-        } else {
-            params.max_hypotheses.saturating_mul(2)
-        }
+        params.max_hypotheses.saturating_mul(self.hypothesis_scale)
     }
 
     /// Original index of position `v`.
@@ -503,7 +506,8 @@ impl PlanePool {
         let Some(near) = &mut self.near else {
             return false;
         };
-        if !super::through_viewpoint(plane.normal.dot(viewpoint) + plane.offset, params) {
+        if !super::viewpoint::through_viewpoint(plane.normal.dot(viewpoint) + plane.offset, params)
+        {
             return false;
         }
         // The near points on the plane (the vector kernel, the same test
@@ -845,7 +849,7 @@ mod tests {
 
     /// Points scattered through a 10 m cube hold no plane any sample could
     /// find well supported, so a round scores as many hypotheses as it may:
-    /// `max_hypotheses` with slivers redrawn, twice that without.
+    /// `max_hypotheses` times the pool's scale, whichever sampler draws them.
     #[test]
     fn a_round_scores_at_most_its_hypothesis_budget() {
         let pts = scattered(&mut Rng::new(6), 20_000);
@@ -853,11 +857,9 @@ mod tests {
             min_inliers: 3,
             ..Params::gpp2()
         };
-        for (reject, budget) in [
-            (true, params.max_hypotheses),
-            (false, 2 * params.max_hypotheses),
-        ] {
-            let mut pool = PlanePool::new(&pts, 1.0, None, Rng::new(7));
+        for (reject, scale) in [(true, 1), (false, 2), (false, 1)] {
+            let budget = scale * params.max_hypotheses;
+            let mut pool = PlanePool::new(&pts, 1.0, None, Rng::new(7)).hypothesis_scale(scale);
             if reject {
                 pool = pool.reject_slivers();
             }

@@ -7,13 +7,11 @@
 
 mod expand;
 mod index;
-pub(crate) mod merge;
-
-pub use merge::MergeEvent;
+pub use crate::merge::MergeEvent;
 
 use crate::clock;
 use crate::cloud::Cloud;
-use crate::detect::{Detector, NO_PRIMITIVE};
+use crate::detect::{CascadePolicy, Detector, NO_PRIMITIVE};
 use crate::error::{Error, Result};
 use crate::params::Params;
 use crate::primitive::Primitive;
@@ -172,7 +170,7 @@ impl Scenario {
         let rest: Vec<u32> = (0..n as u32).filter(|&i| alive[i as usize]).collect();
         report.sent_to_detection = rest.len();
         let pts: Vec<glam::Vec3> = rest.iter().map(|&i| cloud.points[i as usize]).collect();
-        let det = Detector::new(p).largest_cluster_only().run_with_rng(
+        let det = Detector::new(p, CascadePolicy::scenario_leftovers()).run_with_rng(
             &pts,
             cloud.origin,
             sensor,
@@ -201,7 +199,7 @@ impl Scenario {
         if p.expansion {
             let mut changed = report.grown.clone();
             changed.extend_from_slice(&report.added);
-            report.merged = merge::merge_all(&mut self.primitives, &changed, p);
+            report.merged = crate::merge::stats::merge_all(&mut self.primitives, &changed, p);
             for ev in &report.merged {
                 for l in labels.iter_mut().filter(|l| **l == ev.removed) {
                     *l = ev.kept;

@@ -1,0 +1,81 @@
+//! Which of the cascade's rules apply: one-shot detection and the
+//! scenario's detection on each scan's leftovers differ in six of them.
+
+/// The rule set of one detection cascade. The parameters ([`Params`])
+/// say how much (distances, areas, budgets); the policy says which rules
+/// run. [`CascadePolicy::one_shot`] is the full set, for a whole cloud;
+/// [`CascadePolicy::scenario_leftovers`] is the paper's cascade, for the
+/// points a scan's expansion left (about a tenth of a scan, mostly
+/// clutter), where a band lost in one scan comes back with the next.
+///
+/// [`Params`]: crate::params::Params
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CascadePolicy {
+    /// RANSAC never tries a plane through the viewpoint unless the sensor
+    /// stands on it: such a plane holds the laser rings at the sensor's
+    /// height, and a band of every surface it crosses would leave play with
+    /// it. (Candidates through the viewpoint are rejected under every
+    /// policy.)
+    pub skip_edge_on_hypotheses: bool,
+    /// RANSAC draws no sliver triples (three points almost in a line fix a
+    /// line, not a plane, and the noise across it tilts the plane at
+    /// random).
+    pub reject_slivers: bool,
+    /// Hypotheses scored per round: `maxHypotheses` times this.
+    pub hypothesis_scale: usize,
+    /// The ground's clustering tolerance grows with range beyond
+    /// `groundClusterRange`, as the gaps between laser rings do.
+    pub range_pulled_ground: bool,
+    /// Ground footprints fill the gaps between laser rings that the
+    /// range-pulled clustering bridged, so the outline follows every ring
+    /// the clustering joined.
+    pub bridge_ring_gaps: bool,
+    /// Every cluster of a round's plane with `minInliers` points is judged,
+    /// not only the largest: one plane often holds several surfaces (the
+    /// sides of cars parked in a row, the facades along a street).
+    pub every_cluster: bool,
+    /// A final pass merges the pieces of one surface that different rounds
+    /// or clusters found (with outlines that can merge, see
+    /// [`HullKind`](crate::params::HullKind)).
+    pub merge_pieces: bool,
+}
+
+impl CascadePolicy {
+    /// One-shot detection of a whole cloud: every rule.
+    pub const fn one_shot() -> Self {
+        CascadePolicy {
+            skip_edge_on_hypotheses: true,
+            reject_slivers: true,
+            hypothesis_scale: 1,
+            range_pulled_ground: true,
+            bridge_ring_gaps: true,
+            every_cluster: true,
+            merge_pieces: true,
+        }
+    }
+
+    /// The paper's cascade, as the scenario runs it on the points its
+    /// primitives did not explain: the largest cluster of each round's
+    /// plane, fixed clustering tolerances, the plain sampler with twice the
+    /// hypotheses, no merge pass (the scenario merges with its own
+    /// primitives afterwards). Judging every cluster there measured less
+    /// precise and less accurate, and the growing ground tolerance neutral
+    /// (BENCHMARKS.md).
+    pub const fn scenario_leftovers() -> Self {
+        CascadePolicy {
+            skip_edge_on_hypotheses: false,
+            reject_slivers: false,
+            hypothesis_scale: 2,
+            range_pulled_ground: false,
+            bridge_ring_gaps: false,
+            every_cluster: false,
+            merge_pieces: false,
+        }
+    }
+}
+
+impl Default for CascadePolicy {
+    fn default() -> Self {
+        CascadePolicy::one_shot()
+    }
+}

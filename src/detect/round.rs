@@ -1,0 +1,156 @@
+//! The stages of one round of the cascade after RANSAC found its plane:
+//! cluster the plane's inliers, pick the candidates, shape and judge each.
+
+use super::cluster::Clusterer;
+use super::policy::CascadePolicy;
+use super::ransac::LocalPlane;
+use super::viewpoint::{pull_towards, seen_edge_on};
+use crate::geometry::{Frame, Plane};
+use crate::params::Params;
+use crate::primitive::{shape, Shaped};
+use glam::{DVec2, DVec3, Vec3};
+
+/// A round's inliers split into connected clusters in their plane.
+pub(crate) struct Clusters {
+    /// Cluster label of every inlier (not dense).
+    comp: Vec<u32>,
+    /// Size of each label.
+    sizes: Vec<u32>,
+    /// The label of the largest cluster (the first of equals).
+    largest: u32,
+}
+
+impl Clusters {
+    /// Points in the largest cluster.
+    pub(crate) fn largest_size(&self) -> usize {
+        self.sizes
+            .get(self.largest as usize)
+            .map_or(0, |&s| s as usize)
+    }
+}
+
+/// Cluster the inliers (`coords`, local to `origin`) in their plane. The
+/// ground, seen at grazing angles, has its own tolerance, which with
+/// [`CascadePolicy::range_pulled_ground`] grows with range beyond
+/// `groundClusterRange`.
+pub(crate) fn cluster_inliers(
+    clusterer: &mut Clusterer,
+    plane: &LocalPlane,
+    coords: &[Vec3],
+    local_viewpoint: DVec3,
+    p: &Params,
+    policy: &CascadePolicy,
+) -> Clusters {
+    let local = Plane {
+        normal: plane.normal,
+        offset: plane.offset,
+    };
+    let frame = Frame::on_plane(&local, coords[0].as_dvec3());
+    let mut flat: Vec<DVec2> = coords
+        .iter()
+        .map(|p| frame.to_local(p.as_dvec3()))
+        .collect();
+    let tol = if plane.ground {
+        if policy.range_pulled_ground {
+            let foot = frame.to_local(local_viewpoint);
+            pull_towards(&mut flat, foot, p.ground_cluster_range);
+        }
+        p.ground_cluster_tolerance
+    } else {
+        p.cluster_tolerance
+    };
+    let (comp, sizes) = clusterer.clusters(&flat, tol);
+    let largest = comp
+        .iter()
+        .copied()
+        .reduce(|b, c| {
+            if sizes[c as usize] > sizes[b as usize] {
+                c
+            } else {
+                b
+            }
+        })
+        .unwrap_or(0);
+    Clusters {
+        comp,
+        sizes,
+        largest,
+    }
+}
+
+/// A candidate: its points as pool positions and as local coordinates.
+pub(crate) type Candidate = (Vec<u32>, Vec<Vec3>);
+
+/// The candidates of a round: the largest cluster, then with
+/// [`CascadePolicy::every_cluster`] the plane's other clusters of
+/// `minInliers` points or more, largest first (ties in the order of their
+/// first point), so that `maxPrimitives` keeps the larger ones.
+pub(crate) fn candidates(
+    c: &Clusters,
+    inliers: &[u32],
+    coords: &[Vec3],
+    p: &Params,
+    policy: &CascadePolicy,
+) -> Vec<Candidate> {
+    let (comp, sizes) = (&c.comp, &c.sizes);
+    let mut roots = vec![c.largest];
+    let mut slot = vec![u32::MAX; sizes.len()];
+    slot[c.largest as usize] = 0;
+    if policy.every_cluster {
+        for &l in comp {
+            if slot[l as usize] == u32::MAX && sizes[l as usize] as usize >= p.min_inliers {
+                slot[l as usize] = 0;
+                roots.push(l);
+            }
+        }
+        crate::geometry::insertion_sort_by(&mut roots[1..], |&a, &b| {
+            sizes[b as usize].cmp(&sizes[a as usize])
+        });
+        for (k, &l) in roots.iter().enumerate() {
+            slot[l as usize] = k as u32;
+        }
+    }
+    // Their points, in one pass.
+    let mut members: Vec<Candidate> = roots
+        .iter()
+        .map(|&l| {
+            let n = sizes[l as usize] as usize;
+            (Vec::with_capacity(n), Vec::with_capacity(n))
+        })
+        .collect();
+    for (i, &l) in comp.iter().enumerate() {
+        if let Some(m) = members.get_mut(slot[l as usize] as usize) {
+            m.0.push(inliers[i]);
+            m.1.push(coords[i]);
+        }
+    }
+    members
+}
+
+/// A shaped candidate and whether it passed every acceptance test.
+pub(crate) struct Judged {
+    /// The refit, outlined candidate; `None` when degenerate.
+    pub(crate) shaped: Option<Shaped>,
+    /// Large, solid, smooth, consistent and not seen edge-on.
+    pub(crate) accepted: bool,
+}
+
+/// PCA refit, frame, outline, then the acceptance tests: area, width and
+/// solidity ([`Primitive::acceptable`](crate::primitive::Primitive::acceptable)),
+/// roughness, not a plane seen edge-on, normal consistency.
+pub(crate) fn judge(
+    support_pts: &[Vec3],
+    origin: DVec3,
+    viewpoint: DVec3,
+    p: &Params,
+    policy: &CascadePolicy,
+) -> Judged {
+    let shaped = shape(origin, support_pts, p, viewpoint, policy.bridge_ring_gaps);
+    let accepted = shaped.as_ref().is_some_and(|s| {
+        s.primitive.acceptable(p)
+            && s.roughness <= p.max_roughness
+            && !seen_edge_on(s, viewpoint, p)
+            && s.consistency(origin, support_pts, p) >= p.min_normal_consistency
+    });
+    Judged { shaped, accepted }
+}

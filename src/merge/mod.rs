@@ -1,0 +1,88 @@
+//! Merging primitives that are pieces of one surface, which the paper
+//! lacks: two pieces of one long wall detected in different scans, or two
+//! clusters of one plane in one detection, become one primitive once they
+//! are near-coplanar and their outlines touch or overlap.
+//!
+//! One test ([`mergeable`]) and two ways to absorb, by what is at hand:
+//! - [`stats`]: from the primitives' running statistics alone (moments and
+//!   footprints), as the scenario must, since it keeps no points. The older
+//!   id survives.
+//! - [`points`]: with the support points in hand (one-shot detection), so
+//!   that the merged primitive keeps the detection contract (every support
+//!   point near its plane and inside its outline) and the labels follow.
+
+pub(crate) mod points;
+pub(crate) mod stats;
+
+use crate::geometry::polygon::rings_within;
+use crate::params::Params;
+use crate::primitive::Primitive;
+use glam::{DVec2, DVec3};
+use serde::{Deserialize, Serialize};
+
+/// One merge: `removed` was absorbed into `kept`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct MergeEvent {
+    /// Surviving (older) id.
+    pub kept: u32,
+    /// Absorbed id, no longer in the scenario.
+    pub removed: u32,
+}
+
+/// Should `a` and `b` be one primitive? Their planes within `mergeAngle`,
+/// the smaller one on the larger one's plane (or each centroid on the
+/// other's plane) within `mergeDistance`, and their outlines within
+/// `mergeGap` of each other.
+pub fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
+    if a.plane.angle_to(&b.plane) > params.merge_angle.to_radians() {
+        return false;
+    }
+    // The smaller one must lie on the larger one's plane: the RMS distance
+    // of its outline vertices and centroid. A centroid test alone is
+    // meaningless next to a 3000 m^2 road, where a tenth of a degree of tilt
+    // moves the plane by centimetres, and would let a sidewalk (one curb
+    // higher) merge in; a maximum would keep a slightly tilted piece apart
+    // forever.
+    let (av, bv) = (a.vertices(), b.vertices());
+    let (big, small, small_v) = if a.area >= b.area {
+        (a, b, &bv)
+    } else {
+        (b, a, &av)
+    };
+    let ms = small_v
+        .iter()
+        .copied()
+        .chain([small.moments.mean()])
+        .map(|p| {
+            let d = big.plane.signed_distance(p);
+            d * d
+        })
+        .sum::<f64>()
+        / (small_v.len() + 1) as f64;
+    // Or each centroid on the other's plane (two slightly tilted pieces of
+    // one surface whose far vertices disagree).
+    let (ca, cb) = (a.moments.mean(), b.moments.mean());
+    let centroids = a.plane.signed_distance(cb).abs() <= params.merge_distance
+        && b.plane.signed_distance(ca).abs() <= params.merge_distance;
+    if ms.sqrt() > params.merge_distance && !centroids {
+        return false;
+    }
+    let ((alo, ahi), (blo, bhi)) = (bounds(&av), bounds(&bv));
+    let pad = DVec3::splat(params.merge_gap + params.merge_distance);
+    if (alo - pad).cmpgt(bhi).any() || (blo - pad).cmpgt(ahi).any() {
+        return false;
+    }
+    // The outlines, both in a's frame: touching or overlapping?
+    let b_in_a: Vec<DVec2> = bv.iter().map(|&v| a.frame.to_local(v)).collect();
+    rings_within(&a.outline, &b_in_a, params.merge_gap)
+}
+
+fn bounds(pts: &[DVec3]) -> (DVec3, DVec3) {
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for &p in pts {
+        lo = lo.min(p);
+        hi = hi.max(p);
+    }
+    (lo, hi)
+}

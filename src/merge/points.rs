@@ -1,0 +1,321 @@
+//! Merging with the points in hand: one-shot detection's final pass over
+//! the pieces it found. Labels follow the merges, and a merge that would
+//! leave support off its plane or outside its outline is not made.
+
+use super::mergeable;
+use crate::geometry::plane::Moments;
+use crate::geometry::polygon::signed_area;
+use crate::params::Params;
+use crate::primitive::{Primitive, NO_PRIMITIVE};
+use glam::{DVec2, DVec3, Vec3};
+
+/// Merge primitives that are pieces of one surface (the scenario's rule:
+/// near-coplanar, outlines touching or overlapping), then number the
+/// survivors 0, 1, ... again, labels included. A round's plane can cut a
+/// band out of a surface that crosses it at a small angle, and that band is
+/// one of the plane's other clusters; when a later round finds the surface
+/// whole, its outline covers the band. And the pieces of a road beyond a
+/// gap in its rings touch the road once their own rounds outlined them.
+/// For concave outlines (a convex hull of two pieces would cover what lies
+/// between them; the caller decides).
+///
+/// In the order found, a primitive and the newer pieces mergeable with it
+/// become one ([`absorb`]). A merged outline is larger and can touch a
+/// piece it did not touch before, so passes repeat until nothing merges;
+/// after the first, only groups with a primitive grown in the last pass
+/// are looked at.
+#[inline(never)]
+pub(crate) fn merge_pieces(
+    primitives: &mut Vec<Primitive>,
+    labels: &mut [u32],
+    pts: &[Vec3],
+    origin: DVec3,
+    p: &Params,
+) {
+    let n = primitives.len();
+    if n < 2 {
+        return;
+    }
+    let mut into: Vec<u32> = (0..n as u32).collect();
+    let mut grown = vec![true; n];
+    for _ in 0..n {
+        let mut next = vec![false; n];
+        for first in 0..n {
+            if into[first] != first as u32 {
+                continue;
+            }
+            let mut group: Vec<usize> = (first + 1..n)
+                .filter(|&j| {
+                    into[j] == j as u32
+                        && (grown[first] || grown[j])
+                        && mergeable(&primitives[first], &primitives[j], p)
+                })
+                .collect();
+            if group.is_empty() {
+                continue;
+            }
+            group.push(first);
+            let big = group.iter().copied().fold(first, |b, j| {
+                if primitives[j].area > primitives[b].area {
+                    j
+                } else {
+                    b
+                }
+            });
+            group.retain(|&j| j != big);
+            if let Some(out) = absorb(primitives, labels, big, &group, pts, origin, p) {
+                primitives[big] = out;
+                for &j in &group {
+                    into[j] = big as u32;
+                }
+                next[big] = true;
+            }
+        }
+        if !next.contains(&true) {
+            break;
+        }
+        grown = next;
+    }
+    // Survivors in their order, numbered densely; labels follow.
+    let mut dense = vec![NO_PRIMITIVE; n];
+    let mut k = 0;
+    for i in 0..n {
+        if into[i] == i as u32 {
+            dense[i] = k;
+            k += 1;
+        }
+    }
+    if k as usize == n {
+        return;
+    }
+    let mut i = 0;
+    primitives.retain(|_| {
+        i += 1;
+        into[i - 1] == i as u32 - 1
+    });
+    for (k, q) in primitives.iter_mut().enumerate() {
+        q.id = k as u32;
+    }
+    for l in labels.iter_mut() {
+        if *l != NO_PRIMITIVE {
+            *l = dense[*l as usize];
+        }
+    }
+}
+
+/// `primitives[big]` with the pieces `group` absorbed, or `None` when the
+/// merge would break the detection contract (support near its plane,
+/// inside its outline). The largest keeps its plane and frame; the pieces'
+/// points on that plane mark its footprint, and one outline trace follows.
+/// Each piece must keep nine tenths of its support within the inlier
+/// distance of the plane and inside the new raster region, and so must the
+/// largest (the larger footprint's trace can simplify another way); the
+/// points that do not lose their label. Labels are changed only on success.
+fn absorb(
+    primitives: &[Primitive],
+    labels: &mut [u32],
+    big: usize,
+    group: &[usize],
+    pts: &[Vec3],
+    origin: DVec3,
+    p: &Params,
+) -> Option<Primitive> {
+    let n = primitives.len();
+    let world = |i: usize| origin + pts[i].as_dvec3();
+    let mut out = primitives[big].clone();
+    let threshold = if out.ground {
+        p.ground_distance
+    } else {
+        p.distance
+    };
+    // The pieces' points, with their coordinates in `big`'s frame when they
+    // lie on its plane.
+    let mut taken: Vec<(usize, Option<DVec2>)> = Vec::new();
+    let (mut total, mut bad) = (vec![0usize; n], vec![0usize; n]);
+    let mut in_group = vec![false; n];
+    for &j in group {
+        in_group[j] = true;
+    }
+    for (i, &l) in labels.iter().enumerate() {
+        if l != NO_PRIMITIVE && in_group[l as usize] {
+            let w = world(i);
+            let on = out.plane.signed_distance(w).abs() < threshold;
+            total[l as usize] += 1;
+            bad[l as usize] += !on as usize;
+            taken.push((i, on.then(|| out.frame.to_local(w))));
+        }
+    }
+    let marks: Vec<DVec2> = taken.iter().filter_map(|t| t.1).collect();
+    out.footprint.mark_all(&marks);
+    let (ring, region) = out
+        .footprint
+        .outline_region(out.alpha(p), p.simplify, p.max_vertices)?;
+    let mut kept = Vec::with_capacity(taken.len());
+    for &(i, q) in &taken {
+        let stay = q.is_some_and(|q| region.contains(q));
+        bad[labels[i] as usize] += (q.is_some() && !stay) as usize;
+        kept.push(stay);
+    }
+    if group.iter().any(|&j| 10 * bad[j] > total[j]) {
+        return None;
+    }
+    // `out` is `big` with the pieces' cells added (same frame): when the
+    // region holds all of `big`'s cells it holds all of its points.
+    let keeps_own = primitives[big]
+        .footprint
+        .cell_centres()
+        .iter()
+        .all(|&c| region.contains(c));
+    let mut own_out = Vec::new();
+    if !keeps_own {
+        let mut own = 0usize;
+        for (i, &l) in labels.iter().enumerate() {
+            if l == big as u32 {
+                own += 1;
+                if !region.contains(out.frame.to_local(world(i))) {
+                    own_out.push(i);
+                }
+            }
+        }
+        if 10 * own_out.len() > own {
+            return None;
+        }
+    }
+    out.area = signed_area(&ring);
+    out.outline = ring;
+    out.footprint.retain_region(&region);
+    let mut gone = Moments::new(out.moments.reference);
+    for (&(i, _), &stay) in taken.iter().zip(&kept) {
+        if stay {
+            labels[i] = big as u32;
+            out.support += 1;
+        } else {
+            labels[i] = NO_PRIMITIVE;
+            gone.push(world(i));
+        }
+    }
+    for &i in &own_out {
+        labels[i] = NO_PRIMITIVE;
+        gone.push(world(i));
+    }
+    out.support = out.support.saturating_sub(own_out.len() as u64);
+    for &j in group {
+        out.moments.merge(&primitives[j].moments);
+    }
+    out.moments.remove(&gone);
+    Some(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::polygon::distance;
+    use crate::primitive::shape;
+
+    /// Points of a vertical patch in the plane y = `tilt` * z, x in `x0..x1`,
+    /// z in 0..2, on a grid of 5 cm shifted by `shift`.
+    fn patch(x0: f64, x1: f64, tilt: f64, shift: f64) -> Vec<Vec3> {
+        let mut out = Vec::new();
+        let mut x = x0 + shift;
+        while x < x1 {
+            let mut z = shift;
+            while z < 2.0 {
+                out.push(Vec3::new(x as f32, (tilt * z) as f32, z as f32));
+                z += 0.05;
+            }
+            x += 0.05;
+        }
+        out
+    }
+
+    /// Primitives shaped from patches, labelled as detection would.
+    fn pieces(patches: &[&[Vec3]], p: &Params) -> (Vec<Primitive>, Vec<u32>, Vec<Vec3>) {
+        let view = DVec3::new(2.0, -6.0, 1.5);
+        let mut prims = Vec::new();
+        let mut labels = Vec::new();
+        for (id, pts) in patches.iter().enumerate() {
+            let s = shape(DVec3::ZERO, pts, p, view, false).unwrap();
+            assert!(s.kept.iter().all(|&k| k));
+            let mut prim = s.primitive;
+            prim.id = id as u32;
+            prims.push(prim);
+            labels.extend(std::iter::repeat_n(id as u32, pts.len()));
+        }
+        (prims, labels, patches.concat())
+    }
+
+    /// Two primitives shaped from two patches.
+    fn two(a: &[Vec3], b: &[Vec3], p: &Params) -> (Vec<Primitive>, Vec<u32>, Vec<Vec3>) {
+        pieces(&[a, b], p)
+    }
+
+    #[test]
+    fn overlapping_pieces_of_one_surface_merge_and_keep_the_contract() {
+        let p = Params::gpp2();
+        let (a, b) = (patch(0.0, 4.0, 0.0, 0.0), patch(3.0, 7.0, 0.0, 0.025));
+        let (mut prims, mut labels, pts) = two(&a, &b, &p);
+        merge_pieces(&mut prims, &mut labels, &pts, DVec3::ZERO, &p);
+        assert_eq!(prims.len(), 1);
+        let q = &prims[0];
+        assert_eq!(q.id, 0);
+        assert!(labels.iter().all(|&l| l == 0));
+        assert_eq!(q.support, pts.len() as u64);
+        // 7 m x 2 m, outlined through the boundary cells' centres.
+        assert!(q.area > 12.0 && q.area < 14.1, "area {}", q.area);
+        for w in &pts {
+            let w = w.as_dvec3();
+            assert!(q.plane.signed_distance(w).abs() < p.distance);
+            let out = distance(&q.outline, q.frame.to_local(w));
+            assert!(out <= q.footprint.cell() + p.simplify + 1e-9);
+        }
+    }
+
+    /// The first and the third piece lie 3 m apart; the second overlaps
+    /// the first and touches the third. Once the first has absorbed the
+    /// second, its outline touches the third: one primitive in the end.
+    #[test]
+    fn a_merged_outline_takes_in_the_pieces_it_touches_once_grown() {
+        let p = Params::gpp2();
+        let a = patch(0.0, 4.0, 0.0, 0.0);
+        let b = patch(3.0, 7.0, 0.0, 0.025);
+        let c = patch(7.0, 10.0, 0.0, 0.0125);
+        let (mut prims, mut labels, pts) = pieces(&[&a, &b, &c], &p);
+        assert!(!mergeable(&prims[0], &prims[2], &p));
+        assert!(mergeable(&prims[1], &prims[2], &p));
+        merge_pieces(&mut prims, &mut labels, &pts, DVec3::ZERO, &p);
+        assert_eq!(prims.len(), 1);
+        assert!(labels.iter().all(|&l| l == 0));
+        assert_eq!(prims[0].support, pts.len() as u64);
+        // 10 m x 2 m, outlined through the boundary cells' centres.
+        assert!(
+            prims[0].area > 18.0 && prims[0].area < 20.1,
+            "area {}",
+            prims[0].area
+        );
+    }
+
+    #[test]
+    fn pieces_tilted_away_from_the_larger_plane_stay_apart() {
+        let p = Params::gpp2();
+        // 6 degrees apart (within `mergeAngle`), but the smaller's far edge
+        // lies 0.2 m off the larger's plane.
+        let (a, b) = (patch(0.0, 5.0, 0.0, 0.0), patch(4.0, 7.0, 0.105, 0.025));
+        let (mut prims, mut labels, pts) = two(&a, &b, &p);
+        let before = (prims.clone(), labels.clone());
+        merge_pieces(&mut prims, &mut labels, &pts, DVec3::ZERO, &p);
+        assert_eq!(prims.len(), 2);
+        assert_eq!(labels, before.1);
+        assert_eq!(prims[1].area, before.0[1].area);
+    }
+
+    #[test]
+    fn pieces_apart_by_more_than_the_merge_gap_stay_apart() {
+        let p = Params::gpp2();
+        let (a, b) = (patch(0.0, 4.0, 0.0, 0.0), patch(5.0, 8.0, 0.0, 0.0));
+        let (mut prims, mut labels, pts) = two(&a, &b, &p);
+        merge_pieces(&mut prims, &mut labels, &pts, DVec3::ZERO, &p);
+        assert_eq!(prims.len(), 2);
+        assert!(labels[..a.len()].iter().all(|&l| l == 0));
+        assert!(labels[a.len()..].iter().all(|&l| l == 1));
+    }
+}

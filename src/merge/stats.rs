@@ -1,0 +1,75 @@
+//! Merging from running statistics: the scenario's merge after every scan.
+
+use super::{mergeable, MergeEvent};
+use crate::params::{HullKind, Params};
+use crate::primitive::Primitive;
+use glam::DVec2;
+
+/// Absorb `b` into `a`.
+fn absorb(a: &mut Primitive, b: &Primitive, params: &Params) {
+    a.moments.merge(&b.moments);
+    let old_normal = a.plane.normal;
+    if let Some((mut plane, _)) = a.moments.fit_plane() {
+        if plane.normal.dot(old_normal) < 0.0 {
+            plane.normal = -plane.normal;
+            plane.offset = -plane.offset;
+        }
+        a.plane = plane;
+        a.frame = a.frame.realigned(&plane);
+    }
+    let (fa, fb) = (a.frame, b.frame);
+    a.footprint
+        .merge_mapped(&b.footprint, |q| fa.to_local(fb.to_world(q)));
+    let extra: Vec<DVec2> = match params.hull {
+        HullKind::Convex => b.vertices().iter().map(|&v| fa.to_local(v)).collect(),
+        HullKind::Concave => Vec::new(),
+    };
+    a.reshape(params, &extra);
+    a.support += b.support;
+    a.born_scan = a.born_scan.min(b.born_scan);
+    a.last_scan = a.last_scan.max(b.last_scan);
+}
+
+/// Merge until no pair of primitives, one of them in `changed` (ids), is
+/// mergeable. `prims` is sorted by id and stays so.
+pub(crate) fn merge_all(
+    prims: &mut Vec<Primitive>,
+    changed: &[u32],
+    params: &Params,
+) -> Vec<MergeEvent> {
+    let mut events = Vec::new();
+    let mut dirty: Vec<u32> = changed.to_vec();
+    dirty.sort_unstable();
+    dirty.dedup();
+    while let Some(id) = dirty.first().copied() {
+        dirty.remove(0);
+        let Some(ia) = prims.iter().position(|p| p.id == id) else {
+            continue;
+        };
+        let partner =
+            (0..prims.len()).find(|&j| j != ia && mergeable(&prims[ia], &prims[j], params));
+        let Some(ib) = partner else {
+            continue;
+        };
+        // The older (smaller id) survives.
+        let (keep, gone) = if prims[ia].id < prims[ib].id {
+            (ia, ib)
+        } else {
+            (ib, ia)
+        };
+        let b = prims[gone].clone();
+        absorb(&mut prims[keep], &b, params);
+        let kept_id = prims[keep].id;
+        events.push(MergeEvent {
+            kept: kept_id,
+            removed: b.id,
+        });
+        prims.remove(gone);
+        dirty.retain(|&d| d != b.id);
+        // The survivor changed: check it again.
+        if let Err(pos) = dirty.binary_search(&kept_id) {
+            dirty.insert(pos, kept_id);
+        }
+    }
+    events
+}
