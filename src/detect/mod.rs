@@ -12,7 +12,7 @@ use crate::error::Result;
 use crate::geometry::plane::Moments;
 use crate::geometry::polygon::{contains, distance, signed_area};
 use crate::geometry::{Frame, Plane};
-use crate::params::{HullKind, Params};
+use crate::params::Params;
 use crate::primitive::{shape, Primitive, Shaped};
 use crate::rng::Rng;
 use glam::{DVec2, DVec3, Vec3};
@@ -152,7 +152,7 @@ fn merge_pieces(
     p: &Params,
 ) {
     let n = primitives.len();
-    if n < 2 || p.hull != HullKind::Concave {
+    if n < 2 || !p.hull.merges_detected_pieces() {
         return;
     }
     let mut into: Vec<u32> = (0..n as u32).collect();

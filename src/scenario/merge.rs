@@ -4,7 +4,7 @@
 //! older id survives.
 
 use crate::geometry::polygon::rings_within;
-use crate::params::{HullKind, Params};
+use crate::params::Params;
 use crate::primitive::Primitive;
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
@@ -78,10 +78,7 @@ fn absorb(a: &mut Primitive, b: &Primitive, params: &Params) {
     let (fa, fb) = (a.frame, b.frame);
     a.footprint
         .merge_mapped(&b.footprint, |q| fa.to_local(fb.to_world(q)));
-    let extra: Vec<DVec2> = match params.hull {
-        HullKind::Convex => b.vertices().iter().map(|&v| fa.to_local(v)).collect(),
-        HullKind::Concave => Vec::new(),
-    };
+    let extra: Vec<DVec2> = params.hull.carried_vertices(&fb, &b.outline, &fa);
     a.reshape(params, &extra);
     a.support += b.support;
     a.born_scan = a.born_scan.min(b.born_scan);
