@@ -14,25 +14,9 @@
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
-/// How a primitive's outline is computed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum HullKind {
-    /// 2D convex hull of the support (the paper's default). Over-covers
-    /// L-shaped and partly occluded surfaces.
-    Convex,
-    /// Discrete alpha hull of the support's occupancy raster: follows
-    /// concavities wider than `2 * alpha`. Always a simple polygon.
-    Concave,
-}
-
-impl HullKind {
-    /// Can one-shot detection merge the pieces of one surface? A convex
-    /// hull of two pieces would cover what lies between them.
-    pub fn merges_pieces(self) -> bool {
-        self == HullKind::Concave
-    }
-}
+/// How a primitive's outline is computed (the methods live in
+/// [`crate::outline`]).
+pub use crate::outline::HullKind;
 
 /// How "solidity", the paper's second acceptance test, is measured.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]

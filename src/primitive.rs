@@ -3,9 +3,9 @@
 //! that turns a support set into one (PCA refit, outline, area, solidity).
 
 use crate::geometry::plane::{robust_fit, RobustFit};
-use crate::geometry::polygon::{signed_area, simplify};
+use crate::geometry::polygon::signed_area;
 use crate::geometry::{convex_hull, Footprint, Frame, Moments, Plane, Polygon3};
-use crate::params::{HullKind, Params, SolidityKind};
+use crate::params::{Params, SolidityKind};
 use glam::{DVec2, DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 
@@ -113,17 +113,14 @@ impl Primitive {
     /// `extra` are new support points (frame coordinates) for convex hulls.
     /// Returns false (leaving the primitive unchanged) when no outline exists.
     pub(crate) fn reshape(&mut self, params: &Params, extra: &[DVec2]) -> bool {
-        let ring = match params.hull {
-            HullKind::Convex => {
-                let mut pts = self.outline.clone();
-                pts.extend_from_slice(extra);
-                convex_hull(&pts).map(|h| cap_convex(h, params))
-            }
-            HullKind::Concave => {
-                self.footprint
-                    .outline(self.alpha(params), params.simplify, params.max_vertices)
-            }
-        };
+        let ring = params.hull.grown(
+            &self.outline,
+            extra,
+            &self.footprint,
+            self.alpha(params),
+            params.simplify,
+            params.max_vertices,
+        );
         match ring {
             Some(r) if r.len() >= 3 => {
                 self.area = signed_area(&r);
@@ -156,14 +153,6 @@ pub fn min_width(ring: &[DVec2]) -> f64 {
         best = if w < best { w } else { best };
     }
     best
-}
-
-fn cap_convex(h: Vec<DVec2>, params: &Params) -> Vec<DVec2> {
-    if h.len() > params.max_vertices {
-        simplify(&h, params.simplify, params.max_vertices)
-    } else {
-        h
-    }
 }
 
 /// The result of shaping a support set: the primitive (id 0, scans 0) and
@@ -327,21 +316,21 @@ pub(crate) fn shape(
             2.0 * alpha - cell,
         );
     }
-    let (outline, kept, region) = match params.hull {
-        HullKind::Convex => {
-            let h = cap_convex(convex_hull(&q_near)?, params);
-            (h, near, None)
-        }
-        HullKind::Concave => {
-            let (ring, region) =
-                footprint.outline_region(alpha, params.simplify, params.max_vertices)?;
-            let kept: Vec<bool> = q
-                .iter()
-                .zip(&near)
-                .map(|(&p, &k)| k && region.contains(p))
-                .collect();
-            (ring, kept, Some(region))
-        }
+    let (outline, region) = params.hull.outline(
+        &q_near,
+        &footprint,
+        alpha,
+        params.simplify,
+        params.max_vertices,
+    )?;
+    // The method's region, if any, decides which points near the plane stay.
+    let kept: Vec<bool> = match &region {
+        None => near,
+        Some(region) => q
+            .iter()
+            .zip(&near)
+            .map(|(&p, &k)| k && region.contains(p))
+            .collect(),
     };
     let support = kept.iter().filter(|&&k| k).count() as u64;
     if kept.iter().any(|k| !k) {

@@ -209,7 +209,7 @@ impl<'p> Detector<'p> {
             out.steps.push(step);
         }
         // 7. Merge the pieces of one surface that rounds found apart.
-        if policy.merge_pieces && p.hull.merges_pieces() {
+        if policy.merge_pieces && p.hull.merges_detected_pieces() {
             crate::merge::points::merge_pieces(
                 &mut out.primitives,
                 &mut out.labels,

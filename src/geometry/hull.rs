@@ -3,7 +3,7 @@
 //! half a million road points cost one linear pass plus a sort of the few
 //! survivors.
 
-use super::polygon::orient;
+use super::ring::{orient, signed_area};
 use glam::DVec2;
 
 /// Counter-clockwise convex hull without collinear vertices, or `None` when
@@ -15,7 +15,7 @@ pub fn convex_hull(points: &[DVec2]) -> Option<Vec<DVec2>> {
     }
     // A total order (equal means identical): heapsort gives the library
     // sort's result in a fraction of its wasm size.
-    super::heap_sort_by(&mut cand, |a, b| {
+    super::numeric::heap_sort_by(&mut cand, |a, b| {
         a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y))
     });
     cand.dedup();
@@ -78,7 +78,7 @@ fn prefilter(points: &[DVec2]) -> Vec<DVec2> {
             ring.push(p);
         }
     }
-    if ring.len() < 3 || super::polygon::signed_area(&ring) <= 0.0 {
+    if ring.len() < 3 || signed_area(&ring) <= 0.0 {
         return points.to_vec();
     }
     points
@@ -94,7 +94,7 @@ fn prefilter(points: &[DVec2]) -> Vec<DVec2> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::polygon::{contains, is_simple, signed_area};
+    use crate::geometry::polygon::{contains, is_simple};
     use crate::rng::Rng;
 
     #[test]

@@ -1,7 +1,7 @@
 //! A polygon rasterised and grown by a distance: constant-time "is this
 //! point within `reach` of the polygon?" for the many points of a scan.
 
-use super::footprint::dilate_disk;
+use crate::raster::dilate_disk;
 use glam::DVec2;
 
 /// Most cells of a mask; larger extents use coarser cells.
@@ -71,7 +71,7 @@ impl GrownMask {
                     xs.push(a.x + (y - a.y) * (b.x - a.x) / (b.y - a.y));
                 }
             }
-            super::insertion_sort_by(&mut xs, f64::total_cmp);
+            super::numeric::insertion_sort_by(&mut xs, f64::total_cmp);
             for pair in xs.chunks_exact(2) {
                 let c0 = ((pair[0] - origin.x) / cell - 0.5).ceil().max(0.0) as usize;
                 let c1 = ((pair[1] - origin.x) / cell - 0.5).floor();

@@ -426,7 +426,7 @@ pub fn symmetric_eigen3(m: [[f64; 3]; 3]) -> ([f64; 3], [DVec3; 3]) {
         }
     }
     let mut idx = [0usize, 1, 2];
-    super::insertion_sort_by(&mut idx, |&i, &j| a[i][i].total_cmp(&a[j][j]));
+    super::numeric::insertion_sort_by(&mut idx, |&i, &j| a[i][i].total_cmp(&a[j][j]));
     let vals = [a[idx[0]][idx[0]], a[idx[1]][idx[1]], a[idx[2]][idx[2]]];
     let col = |j: usize| DVec3::new(v[0][j], v[1][j], v[2][j]);
     (vals, [col(idx[0]), col(idx[1]), col(idx[2])])

@@ -2,29 +2,9 @@
 //! planar polygons in 3D.
 
 use super::plane::{Frame, Plane};
+pub use super::ring::{orient, signed_area};
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
-
-/// The signed area (positive when counter-clockwise).
-pub fn signed_area(ring: &[DVec2]) -> f64 {
-    let n = ring.len();
-    if n < 3 {
-        return 0.0;
-    }
-    let mut s = 0.0;
-    for i in 0..n {
-        let a = ring[i];
-        let b = ring[(i + 1) % n];
-        s += a.x * b.y - a.y * b.x;
-    }
-    0.5 * s
-}
-
-/// Orientation of the triangle `a, b, c`: > 0 counter-clockwise.
-#[inline]
-pub fn orient(a: DVec2, b: DVec2, c: DVec2) -> f64 {
-    (b - a).perp_dot(c - a)
-}
 
 /// Squared distance from `p` to the segment `a b`.
 #[inline]
@@ -375,7 +355,7 @@ fn closest_sq(a: &[DVec2], b: &[DVec2], skip: f64, enough: f64) -> f64 {
     }
     let edge_box = |r: DVec2, s: DVec2| {
         let (mut lo, mut hi) = (r, r);
-        super::grow_box(&mut lo, &mut hi, s);
+        super::numeric::grow_box(&mut lo, &mut hi, s);
         (lo, hi)
     };
     let boxes: Vec<(DVec2, DVec2)> = (0..b.len())

@@ -1,7 +1,7 @@
 //! Merging from running statistics: the scenario's merge after every scan.
 
 use super::{mergeable, MergeEvent};
-use crate::params::{HullKind, Params};
+use crate::params::Params;
 use crate::primitive::Primitive;
 use glam::DVec2;
 
@@ -20,10 +20,7 @@ fn absorb(a: &mut Primitive, b: &Primitive, params: &Params) {
     let (fa, fb) = (a.frame, b.frame);
     a.footprint
         .merge_mapped(&b.footprint, |q| fa.to_local(fb.to_world(q)));
-    let extra: Vec<DVec2> = match params.hull {
-        HullKind::Convex => b.vertices().iter().map(|&v| fa.to_local(v)).collect(),
-        HullKind::Concave => Vec::new(),
-    };
+    let extra: Vec<DVec2> = params.hull.carried_vertices(&fb, &b.outline, &fa);
     a.reshape(params, &extra);
     a.support += b.support;
     a.born_scan = a.born_scan.min(b.born_scan);

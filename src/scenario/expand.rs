@@ -26,7 +26,7 @@ use crate::cloud::Cloud;
 use crate::detect::cluster::Clusterer;
 use crate::geometry::convex_hull;
 use crate::geometry::mask::{GrownMask, Zone};
-use crate::params::{HullKind, Params};
+use crate::params::Params;
 use crate::primitive::Primitive;
 use glam::{DVec2, DVec3};
 
@@ -231,7 +231,7 @@ fn grow(
             }
         }
         first = false;
-        if new == 0 || params.hull != HullKind::Convex {
+        if new == 0 || !params.hull.grows_by_hull() {
             break;
         }
         let mut pts = outline.to_vec();
