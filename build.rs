@@ -1,22 +1,21 @@
 //! Generates the TypeScript declaration of the pipeline options for the JS
-//! package from the `Params` struct in `src/params.rs`: one optional
-//! camelCase key per field, typed from the Rust type, documented with the
-//! field's doc comment (which gives unit and default). `src/wasm.rs` includes
-//! it in the `.d.ts`, so the typings follow the parameters without a second
-//! copy to keep in sync.
+//! package from the options table `src/params/table.rs` (which the crate
+//! includes too): one optional camelCase key per option, typed from the Rust
+//! type, documented with the option's doc comment (unit and default) and its
+//! range. `src/wasm.rs` includes it in the `.d.ts`, so the typings follow the
+//! parameters without a second copy to keep in sync.
 
 use std::fs;
 use std::path::Path;
 
 fn main() {
-    println!("cargo:rerun-if-changed=src/params.rs");
+    println!("cargo:rerun-if-changed=src/params/table.rs");
     println!("cargo:rerun-if-changed=build.rs");
-    let src = fs::read_to_string("src/params.rs").unwrap_or_default();
     let out = std::env::var("OUT_DIR").unwrap_or_else(|_| ".".into());
     // A failure to write is a build error worth seeing.
     if let Err(e) = fs::write(
         Path::new(&out).join("pipeline_options.d.ts"),
-        pipeline_options_ts(&src),
+        pipeline_options_ts(),
     ) {
         panic!("cannot write the generated TypeScript: {e}");
     }
@@ -51,39 +50,90 @@ fn ts_type(rust: &str) -> &'static str {
     }
 }
 
-fn pipeline_options_ts(src: &str) -> String {
+/// An option's valid range, as `src/params/table.rs` declares it (the same
+/// variants as `Check` in `src/params/mod.rs`, which enforces them; here
+/// they are only printed).
+#[allow(dead_code)]
+#[derive(Clone, Copy)]
+enum Check {
+    Any,
+    Finite,
+    Positive(f64),
+    Between(f64, f64),
+    NonNegative,
+    Fraction,
+    Open01,
+    Count(usize, usize),
+    AtLeastOne,
+}
+
+impl Check {
+    /// The range in words, or `None` when any value of the type is valid.
+    fn describe(self) -> Option<String> {
+        Some(match self {
+            Check::Any => return None,
+            Check::Finite => "finite numbers".into(),
+            Check::Positive(max) => format!("(0, {max}]"),
+            Check::Between(lo, hi) => format!("[{lo}, {hi}]"),
+            Check::NonNegative => ">= 0".into(),
+            Check::Fraction => "[0, 1]".into(),
+            Check::Open01 => "(0, 1)".into(),
+            Check::Count(lo, hi) => format!("integer in [{lo}, {hi}]"),
+            Check::AtLeastOne => "integer >= 1".into(),
+        })
+    }
+}
+
+/// One row of the options table.
+struct Row {
+    key: &'static str,
+    ty: &'static str,
+    docs: &'static [&'static str],
+    unit: &'static str,
+    check: Check,
+}
+
+macro_rules! options {
+    ($( $(#[doc = $doc:literal])* $key:ident : $ty:ty = $($path:ident).+ , $unit:literal , $check:expr ; )*) => {
+        fn option_rows() -> Vec<Row> {
+            vec![$( Row {
+                key: stringify!($key),
+                ty: stringify!($ty),
+                docs: &[$($doc),*],
+                unit: $unit,
+                check: $check,
+            }, )*]
+        }
+    };
+}
+
+include!("src/params/table.rs");
+
+fn pipeline_options_ts() -> String {
     let mut out = String::from(
         "/**\n * Options of the pipeline (detection and incremental scenario), generated\n \
-         * from the Rust `Params`. Every key is optional: the preset's value is\n \
-         * used for a missing key. An unknown key, a wrong type or an out-of-range\n \
-         * value throws an Error naming the key. Distances in metres, areas in\n \
-         * square metres, angles in degrees.\n */\nexport interface PipelineOptions {\n  \
+         * from the options table of the Rust `Params`. Every key is optional: the\n \
+         * preset's value is used for a missing key. An unknown key, a wrong type\n \
+         * or an out-of-range value throws an Error naming the key. Distances in\n \
+         * metres, areas in square metres, angles in degrees.\n */\nexport interface PipelineOptions {\n  \
          /** Starting values for every other key: \"gpp1\" (the paper's GPP 1, only\n   \
          * large polygons) or \"gpp2\" (GPP 2, small polygons too). Default \"gpp2\". */\n  \
          preset?: Preset;\n",
     );
-    let body = src
-        .split_once("pub struct Params {")
-        .map(|(_, rest)| rest.split("\n}").next().unwrap_or(""))
-        .unwrap_or("");
-    let mut doc: Vec<String> = Vec::new();
-    for line in body.lines().map(str::trim) {
-        if let Some(d) = line.strip_prefix("///") {
-            doc.push(d.trim().replace("*/", "* /"));
-        } else if let Some(field) = line.strip_prefix("pub ") {
-            if let Some((name, ty)) = field.split_once(':') {
-                let ty = ty.trim().trim_end_matches(',').trim();
-                out.push_str("  /**\n");
-                for d in &doc {
-                    out.push_str(&format!("   * {d}\n").replace("* \n", "*\n"));
-                }
-                out.push_str("   */\n");
-                out.push_str(&format!("  {}?: {};\n", camel(name.trim()), ts_type(ty)));
-            }
-            doc.clear();
-        } else if !line.starts_with("#[") {
-            doc.clear();
+    for row in option_rows() {
+        out.push_str("  /**\n");
+        for d in row.docs {
+            let d = d.trim().replace("*/", "* /");
+            out.push_str(&format!("   * {d}\n").replace("* \n", "*\n"));
         }
+        if !row.unit.is_empty() {
+            out.push_str(&format!("   * Unit: {}.\n", row.unit));
+        }
+        if let Some(range) = row.check.describe() {
+            out.push_str(&format!("   * Range: {range}.\n"));
+        }
+        out.push_str("   */\n");
+        out.push_str(&format!("  {}?: {};\n", camel(row.key), ts_type(row.ty)));
     }
     out.push_str("}\n");
     out

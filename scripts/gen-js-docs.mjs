@@ -58,11 +58,10 @@ export function sameValue(stated, value) {
   }
 }
 
+/** The unit the options table declares (the generated "Unit: m." line). */
 function unitOf(doc) {
-  const m = doc.match(/\((m|m\^2|deg|points\/m\^2)\)/);
-  if (m) return m[1];
-  if (/\(0\.\.1\)/.test(doc)) return "0..1";
-  return "";
+  const m = doc.match(/Unit: (\S+)\./);
+  return m ? m[1] : "";
 }
 
 function show(v) {
@@ -87,7 +86,8 @@ export function optionsTable() {
     const d = key === "preset" ? "gpp2" : gpp2[key];
     const g = key === "preset" ? undefined : JSON.stringify(gpp1[key]) !== JSON.stringify(d) ? gpp1[key] : undefined;
     const t = key === "preset" ? '"gpp1" \\| "gpp2"' : esc(type);
-    rows.push(`| \`${key}\` | ${t} | ${unitOf(doc)} | ${show(d)} | ${show(g)} | ${esc(doc)} |`);
+    const meaning = doc.replace(/\s*Unit: \S+\./, "");
+    rows.push(`| \`${key}\` | ${t} | ${unitOf(doc)} | ${show(d)} | ${show(g)} | ${esc(meaning)} |`);
   }
   return rows.join("\n");
 }

@@ -102,11 +102,7 @@ impl Primitive {
 
     /// Outline radius used for this primitive (m).
     pub fn alpha(&self, params: &Params) -> f64 {
-        if self.ground {
-            params.ground_alpha
-        } else {
-            params.alpha
-        }
+        params.surface(self.ground).alpha
     }
 
     /// Recompute the outline after the footprint or hull points changed.
@@ -187,7 +183,7 @@ impl Shaped {
             &self.q,
             &self.kept,
             &self.primitive.frame,
-            2.0 * params.cell,
+            2.0 * params.other.cell,
         )
     }
 }
@@ -279,39 +275,28 @@ pub(crate) fn shape(
     // towards the sensor, facing up).
     let ground = plane.is_ground_below(viewpoint, libm::cos(tilt), params.ground_depth);
     let frame = Frame::on_plane(&plane, moments.mean());
+    let surface = params.surface(ground);
     // Support is what lies within the inlier distance of the final plane.
-    let threshold = if ground {
-        params.ground_distance
-    } else {
-        params.distance
-    };
+    let threshold = surface.distance;
     let near: Vec<bool> = world
         .iter()
         .map(|&p| plane.signed_distance(p).abs() < threshold)
         .collect();
     let q: Vec<DVec2> = world.iter().map(|&p| frame.to_local(p)).collect();
-    let alpha = if ground {
-        params.ground_alpha
-    } else {
-        params.alpha
-    };
+    let alpha = surface.alpha;
     let q_near: Vec<DVec2> = q
         .iter()
         .zip(&near)
         .filter_map(|(&p, &k)| k.then_some(p))
         .collect();
-    let cell = if ground {
-        params.ground_cell
-    } else {
-        params.cell
-    };
+    let cell = surface.cell;
     let mut footprint = Footprint::new(cell);
     footprint.mark_all(&q_near);
     if ground && ring_gaps {
         footprint.bridge_towards(
             frame.to_local(viewpoint),
             params.ground_cluster_range,
-            params.ground_cluster_tolerance,
+            params.ground.cluster_tolerance,
             // Narrower gaps are closed by the outline anyway.
             2.0 * alpha - cell,
         );

@@ -136,15 +136,15 @@ fn staircase_gives_each_tread_and_riser() {
     let cloud = cloud(&pts);
     // A small-scale scene: finer raster and width limits than the street
     // defaults (risers are 0.4 m tall once the treads took their edges).
-    let p = Params {
+    let mut p = Params {
         min_area: 1.0,
         min_width: 0.2,
-        cell: 0.08,
-        distance: 0.05,
-        ground_distance: 0.05,
         viewpoint: [3.0, 2.0, 5.0],
         ..Params::gpp2()
     };
+    p.other.cell = 0.08;
+    p.other.distance = 0.05;
+    p.ground.distance = 0.05;
     let det = detect(&cloud, &p).unwrap();
     check_invariants(&cloud, &det, &p);
     let treads: Vec<f64> = det
@@ -442,10 +442,8 @@ fn bad_values_are_errors_not_panics() {
         Cloud::from_flat(&[0.0; 6], 2),
         Err(Error::BadStride(2))
     ));
-    let bad = Params {
-        distance: -1.0,
-        ..Params::gpp2()
-    };
+    let mut bad = Params::gpp2();
+    bad.other.distance = -1.0;
     let e = detect(&Cloud::default(), &bad).unwrap_err();
     assert!(e.to_string().contains("distance"));
 }
@@ -933,7 +931,7 @@ fn ground_rings_join_under_the_ground_clustering_tolerance() {
         .chain((0..8).map(|k| 12.8 + 0.8 * k as f64))
         .collect();
     let cloud = cloud(&ground_rings(&radii, 0.03, &mut rng));
-    let ground_area = |tol: f64| largest_ground_area(&cloud, |p| p.ground_cluster_tolerance = tol);
+    let ground_area = |tol: f64| largest_ground_area(&cloud, |p| p.ground.cluster_tolerance = tol);
     let annulus = std::f64::consts::PI * (18.4f64.powi(2) - 3.0f64.powi(2));
     let near = std::f64::consts::PI * (11.85f64.powi(2) - 3.0f64.powi(2));
     let joined = ground_area(1.0);
@@ -941,7 +939,7 @@ fn ground_rings_join_under_the_ground_clustering_tolerance() {
         joined > 0.9 * annulus && joined < 1.05 * annulus,
         "one polygon over all rings: {joined} m^2 of {annulus}"
     );
-    let split = ground_area(Params::gpp2().ground_cluster_tolerance);
+    let split = ground_area(Params::gpp2().ground.cluster_tolerance);
     assert!(
         split > 0.9 * near && split < 1.1 * near,
         "the near disc only: {split} m^2 of {near}"
@@ -997,7 +995,7 @@ fn far_ground_rings_join_beyond_the_ground_clustering_range() {
 fn the_ground_outline_follows_far_rings_as_far_as_they_cluster() {
     let mut rng = Rng::new(13);
     let p = Params::gpp2();
-    let (range, tol) = (p.ground_cluster_range, p.ground_cluster_tolerance);
+    let (range, tol) = (p.ground_cluster_range, p.ground.cluster_tolerance);
     let reach = |r: f64| tol * r * r / (range * range + tol * r);
     let mut radii = vec![3.0f64];
     while let Some(&r) = radii.last().filter(|&&r| r < 80.0) {

@@ -417,11 +417,7 @@ impl PlanePool {
             LocalPlane {
                 normal,
                 offset,
-                threshold: if ground {
-                    params.ground_distance
-                } else {
-                    params.distance
-                },
+                threshold: params.surface(ground).distance,
                 ground,
             }
         };

@@ -50,15 +50,11 @@ pub(crate) fn cluster_inliers(
         .iter()
         .map(|p| frame.to_local(p.as_dvec3()))
         .collect();
-    let tol = if plane.ground {
-        if policy.range_pulled_ground {
-            let foot = frame.to_local(local_viewpoint);
-            pull_towards(&mut flat, foot, p.ground_cluster_range);
-        }
-        p.ground_cluster_tolerance
-    } else {
-        p.cluster_tolerance
-    };
+    if plane.ground && policy.range_pulled_ground {
+        let foot = frame.to_local(local_viewpoint);
+        pull_towards(&mut flat, foot, p.ground_cluster_range);
+    }
+    let tol = p.surface(plane.ground).cluster_tolerance;
     let (comp, sizes) = clusterer.clusters(&flat, tol);
     let largest = comp
         .iter()

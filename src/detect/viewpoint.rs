@@ -10,7 +10,7 @@ use glam::{DVec2, DVec3};
 /// (within two inlier distances)? Every ray from the sensor to such a plane
 /// grazes it. The test of both the RANSAC hypotheses and the candidates.
 pub(crate) fn through_viewpoint(d: f64, p: &Params) -> bool {
-    d.abs() < 2.0 * p.distance
+    d.abs() < 2.0 * p.other.distance
 }
 
 /// Is this candidate a plane the sensor lies in, away from it? Its plane

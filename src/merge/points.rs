@@ -123,11 +123,7 @@ fn absorb(
     let n = primitives.len();
     let world = |i: usize| origin + pts[i].as_dvec3();
     let mut out = primitives[big].clone();
-    let threshold = if out.ground {
-        p.ground_distance
-    } else {
-        p.distance
-    };
+    let threshold = p.surface(out.ground).distance;
     // The pieces' points, with their coordinates in `big`'s frame when they
     // lie on its plane.
     let mut taken: Vec<(usize, Option<DVec2>)> = Vec::new();
@@ -264,7 +260,7 @@ mod tests {
         assert!(q.area > 12.0 && q.area < 14.1, "area {}", q.area);
         for w in &pts {
             let w = w.as_dvec3();
-            assert!(q.plane.signed_distance(w).abs() < p.distance);
+            assert!(q.plane.signed_distance(w).abs() < p.other.distance);
             let out = distance(&q.outline, q.frame.to_local(w));
             assert!(out <= q.footprint.cell() + p.simplify + 1e-9);
         }

@@ -54,11 +54,8 @@ pub(crate) fn expand(
     params: &Params,
     scan: u64,
 ) -> usize {
-    let (max_across, along) = if prim.ground {
-        (params.ground_expand_across, params.ground_expand_along)
-    } else {
-        (params.expand_across, params.expand_along)
-    };
+    let surface = params.surface(prim.ground);
+    let (max_across, along) = (surface.expand_across, surface.expand_along);
     // The gate adapts to how flat this primitive really is.
     let sigma = prim.rms();
     let across = (3.0 * sigma).clamp(0.03, max_across);

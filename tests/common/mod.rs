@@ -102,11 +102,7 @@ pub fn check_invariants(cloud: &Cloud, det: &Detection, p: &Params) {
         let prim = &det.primitives[l as usize];
         counts[l as usize] += 1;
         let w = cloud.world(i);
-        let thr = if prim.ground {
-            p.ground_distance
-        } else {
-            p.distance
-        };
+        let thr = p.surface(prim.ground).distance;
         let d = prim.plane.signed_distance(w).abs();
         assert!(d < thr, "point {i} is {d} m from plane of {l}");
         // Concave outlines pass through the centres of the boundary raster
