@@ -464,7 +464,7 @@ impl Crate {
     fn resolve(&self, abs: &ModPath, hops: usize) -> ModPath {
         let n = (0..=abs.len())
             .rev()
-            .find(|&n| self.modules.contains(&abs[..n].to_vec()))
+            .find(|&n| self.modules.contains(&abs[..n]))
             .unwrap_or(0);
         let module = abs[..n].to_vec();
         if hops < 8 {
@@ -574,7 +574,7 @@ fn graph(src: &Path) -> Graph {
         scanned.push((module, refs));
     }
     // Files of test-only modules, and everything below them, are skipped.
-    scanned.retain(|(m, _)| !(1..=m.len()).any(|n| test_files.contains(&m[..n].to_vec())));
+    scanned.retain(|(m, _)| !(1..=m.len()).any(|n| test_files.contains(&m[..n])));
     let mut krate = Crate {
         modules: scanned.iter().map(|(m, _)| m.clone()).collect(),
         reexports: BTreeMap::new(),
