@@ -1,13 +1,13 @@
 //! The `polyscene` command-line tool: batch detection, simulation, replay
-//! and evaluation. Run `polyscene help` for usage.
+//! and evaluation. Run `polyscene --help` for usage. The logic is
+//! `polyscene::cli` (native builds only; on wasm32 this is an empty program).
 
-use polyscene::cli;
-
+#[cfg(not(target_arch = "wasm32"))]
 fn main() {
+    use std::io::Write;
     let args: Vec<String> = std::env::args().skip(1).collect();
-    match cli::run(&args) {
+    match polyscene::cli::run(&args) {
         Ok(out) => {
-            use std::io::Write;
             if !out.is_empty() {
                 // A closed pipe (`| head`) is not an error worth a panic.
                 let _ = writeln!(std::io::stdout(), "{out}");
@@ -19,3 +19,6 @@ fn main() {
         }
     }
 }
+
+#[cfg(target_arch = "wasm32")]
+fn main() {}

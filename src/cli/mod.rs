@@ -1,69 +1,276 @@
 //! The command-line tool's logic, kept in the library so it is tested like
-//! everything else. `run` takes the arguments after the program name and
-//! returns what to print on stdout, or an error for stderr.
-
-mod args;
+//! everything else. [`run`] takes the arguments after the program name and
+//! returns what to print on stdout (the polygons, a report, or the help
+//! text), or an error for stderr.
+//!
+//! The arguments are parsed by `clap`. The pipeline options of `detect` and
+//! `replay` are not listed here: [`command`] adds one `--kebab-case` option
+//! per [`Params::keys`] key (`minArea` is `--min-area`), so a new parameter
+//! is on the command line by itself, and their values go through
+//! [`Params::from_options`], the parser (and error messages) of the JS
+//! options.
 
 use crate::cloud::Cloud;
 use crate::error::{Error, Result};
-use crate::params::{HullKind, Params};
+use crate::params::Params;
 use crate::primitive::Primitive;
-use args::Args;
+use clap::error::ErrorKind;
+use clap::{Arg, ArgAction, ArgMatches, Args, CommandFactory, FromArgMatches, Parser, Subcommand};
 use serde::Serialize;
+use serde_json::{Map, Value};
 use std::path::Path;
 
-const USAGE: &str = "\
-usage:
-  polyscene detect CLOUD.bin [--stride 3|4] [--preset gpp1|gpp2] [--hull convex|concave]
-                   [--seed N] [--out FILE.json]
-      one-shot detection of a world-frame cloud (little-endian f32, stride 4 = KITTI .bin)
-  polyscene replay DIR [--preset gpp1|gpp2] [--hull convex|concave] [--seed N]
-                   [--no-expansion] [--out FILE.json] [--report FILE.jsonl]
-      incremental scenario over DIR/NNNNNN.bin (sensor frame) with DIR/poses.txt (KITTI)
-  polyscene simulate street|crossing [--seed N] [--scans K] --out DIR
-      write a simulated HDL-64E drive with labels and ground truth
-  polyscene eval PRED.json GT_DIR
-      score polygons against a simulated dataset's ground truth
-  polyscene help";
+/// Heading of the pipeline options in `--help`.
+const PIPELINE_HEADING: &str = "Pipeline options (the keys of the JS options)";
 
-/// Run one command; returns the text for stdout.
+#[derive(Parser)]
+#[command(
+    name = "polyscene",
+    version,
+    about = "Planar polygon maps from LiDAR scans: detection, incremental replay, \
+             simulation and evaluation",
+    arg_required_else_help = true
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Cmd,
+}
+
+#[derive(Subcommand)]
+enum Cmd {
+    /// One-shot detection of a world-frame cloud (little-endian f32; stride 4 = KITTI .bin)
+    Detect(DetectArgs),
+    /// Incremental scenario over DIR/NNNNNN.bin (sensor frame) with DIR/poses.txt (KITTI)
+    Replay(ReplayArgs),
+    /// Write a simulated HDL-64E drive with labels and ground truth
+    Simulate(SimulateArgs),
+    /// Score polygons against a simulated dataset's ground truth
+    Eval(EvalArgs),
+}
+
+#[derive(Args)]
+struct DetectArgs {
+    /// The cloud: little-endian f32 values, `--stride` of them per point
+    #[arg(value_name = "CLOUD.bin")]
+    cloud: String,
+    /// Values per point: 3 (x, y, z) or 4 (x, y, z, intensity)
+    #[arg(long, value_name = "3|4", default_value_t = 4)]
+    stride: usize,
+    #[command(flatten)]
+    pipeline: PipelineArgs,
+    /// Write the polygons (JSON) to FILE instead of stdout
+    #[arg(long, value_name = "FILE.json")]
+    out: Option<String>,
+}
+
+#[derive(Args)]
+struct ReplayArgs {
+    /// The dataset: NNNNNN.bin scans (sensor frame, stride 4) and poses.txt
+    #[arg(value_name = "DIR")]
+    dir: String,
+    #[command(flatten)]
+    pipeline: PipelineArgs,
+    /// Write the polygons (JSON) to FILE instead of stdout
+    #[arg(long, value_name = "FILE.json")]
+    out: Option<String>,
+    /// Write each scan's report (one JSON line per scan) to FILE
+    #[arg(long, value_name = "FILE.jsonl")]
+    report: Option<String>,
+}
+
+/// Options of `detect` and `replay` besides the per-key pipeline options.
+#[derive(Args)]
+struct PipelineArgs {
+    /// The parameter set the pipeline options override [default: gpp2]
+    #[arg(long, value_name = "gpp1|gpp2", help_heading = PIPELINE_HEADING)]
+    preset: Option<String>,
+    /// Same as --expansion false: the paper's mode without expansion
+    #[arg(long, conflicts_with = "expansion", help_heading = PIPELINE_HEADING)]
+    no_expansion: bool,
+}
+
+#[derive(Args)]
+struct SimulateArgs {
+    /// The scene layout: street or crossing
+    #[arg(value_name = "LAYOUT")]
+    layout: String,
+    /// Seed of the scene
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Number of scans to write
+    #[arg(long, default_value_t = 100)]
+    scans: usize,
+    /// Directory to write the dataset to (created if missing)
+    #[arg(long, value_name = "DIR", required = true)]
+    out: String,
+}
+
+#[derive(Args)]
+struct EvalArgs {
+    /// Polygons to score: a JSON document as `detect` and `replay` write
+    #[arg(value_name = "PRED.json")]
+    pred: String,
+    /// A simulated dataset with ground_truth.json and .label files
+    #[arg(value_name = "GT_DIR")]
+    gt_dir: String,
+}
+
+/// `minArea` -> `min-area`.
+fn kebab(key: &str) -> String {
+    let mut out = String::with_capacity(key.len() + 4);
+    for c in key.chars() {
+        if c.is_ascii_uppercase() {
+            out.push('-');
+            out.push(c.to_ascii_lowercase());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
+/// One `--kebab-case` option per pipeline parameter, on `cmd`.
+fn with_pipeline_options(mut cmd: clap::Command) -> clap::Command {
+    let defaults = serde_json::to_value(Params::gpp2()).unwrap_or_default();
+    for key in Params::keys() {
+        let default = defaults.get(&key).cloned().unwrap_or(Value::Null);
+        let value_name = match &default {
+            Value::Bool(_) => "true|false",
+            Value::Number(n) if n.is_f64() => "X",
+            Value::Number(_) => "N",
+            Value::Array(_) => "X,Y,...",
+            _ => "NAME",
+        };
+        let shown = match &default {
+            Value::String(s) => s.clone(),
+            Value::Array(a) => a.iter().map(Value::to_string).collect::<Vec<_>>().join(","),
+            v => v.to_string(),
+        };
+        cmd = cmd.arg(
+            Arg::new(key.clone())
+                .long(kebab(&key))
+                .value_name(value_name)
+                .action(ArgAction::Set)
+                .allow_hyphen_values(true)
+                .help_heading(PIPELINE_HEADING)
+                .help(format!("Option `{key}` [gpp2: {shown}]")),
+        );
+    }
+    cmd
+}
+
+/// The whole command line: the derived commands plus the pipeline options.
+pub fn command() -> clap::Command {
+    Cli::command()
+        .mut_subcommand("detect", with_pipeline_options)
+        .mut_subcommand("replay", with_pipeline_options)
+}
+
+/// Run one command; returns the text for stdout. `--help` and `--version`
+/// return their text; a usage error is an [`Error::Invalid`] with clap's
+/// message (suggestions included).
 pub fn run(argv: &[String]) -> Result<String> {
-    let Some((cmd, rest)) = argv.split_first() else {
-        return Err(Error::Invalid(format!("no command given\n{USAGE}")));
+    let args = std::iter::once("polyscene".to_string()).chain(argv.iter().cloned());
+    let matches = match command().try_get_matches_from(args) {
+        Ok(m) => m,
+        Err(e) => {
+            let text = e.render().to_string();
+            return match e.kind() {
+                ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
+                    Ok(text.trim_end().to_string())
+                }
+                _ => Err(Error::Invalid(
+                    text.trim_end()
+                        .strip_prefix("error: ")
+                        .unwrap_or(text.trim_end())
+                        .to_string(),
+                )),
+            };
+        }
     };
-    let mut args = Args::parse(rest)?;
-    match cmd.as_str() {
-        "detect" => detect_cmd(&mut args),
-        "replay" => replay_cmd(&mut args),
-        "simulate" => simulate_cmd(&mut args),
-        "eval" => eval_cmd(&mut args),
-        "help" | "--help" | "-h" => Ok(USAGE.to_string()),
-        other => Err(Error::Invalid(format!(
-            "unknown command '{other}'\n{USAGE}"
-        ))),
+    let cli = Cli::from_arg_matches(&matches).map_err(|e| Error::Invalid(e.to_string()))?;
+    let sub = matches.subcommand().map(|(_, m)| m);
+    match cli.command {
+        Cmd::Detect(a) => {
+            let params = params_from(&a.pipeline, sub)?;
+            detect_cmd(a, params)
+        }
+        Cmd::Replay(a) => {
+            let params = params_from(&a.pipeline, sub)?;
+            replay_cmd(a, params)
+        }
+        Cmd::Simulate(a) => simulate_cmd(a),
+        Cmd::Eval(a) => eval_cmd(a),
     }
 }
 
-/// Parameters from `--preset`, `--hull` and `--seed`.
-fn params_from(args: &mut Args) -> Result<Params> {
-    let mut p = Params::preset(args.take("preset").as_deref().unwrap_or("gpp2"))?;
-    if let Some(h) = args.take("hull") {
-        p.hull = match h.as_str() {
-            "convex" => HullKind::Convex,
-            "concave" => HullKind::Concave,
-            o => {
-                return Err(Error::BadOption {
-                    key: "hull".into(),
-                    reason: format!("expected 'convex' or 'concave', got '{o}'"),
+/// A command-line value as JSON, as the JS options would give it: `true`
+/// and `false` are booleans, numbers are numbers (integers when they are
+/// one, so that integer options accept `150`), `a,b,c` is an array of
+/// numbers, anything else a string. [`Params::from_options`] then checks
+/// types and ranges.
+fn option_value(key: &str, text: &str) -> Result<Value> {
+    fn number(key: &str, text: &str) -> Option<Result<Value>> {
+        let x: f64 = text.trim().parse().ok()?;
+        Some(if !x.is_finite() {
+            Err(Error::BadOption {
+                key: key.into(),
+                reason: format!("must be a finite number, got {text}"),
+            })
+        } else if x.fract() == 0.0 && x.abs() <= 9_007_199_254_740_991.0 {
+            Ok(if x >= 0.0 {
+                Value::from(x as u64)
+            } else {
+                Value::from(x as i64)
+            })
+        } else {
+            Ok(Value::from(x))
+        })
+    }
+    match text {
+        "true" => return Ok(Value::Bool(true)),
+        "false" => return Ok(Value::Bool(false)),
+        _ => {}
+    }
+    if let Some(v) = number(key, text) {
+        return v;
+    }
+    if text.contains(',') {
+        return text
+            .split(',')
+            .enumerate()
+            .map(|(i, t)| {
+                number(key, t).unwrap_or_else(|| {
+                    Err(Error::BadOption {
+                        key: key.into(),
+                        reason: format!("element {i} of '{text}' is not a number"),
+                    })
                 })
+            })
+            .collect::<Result<Vec<Value>>>()
+            .map(Value::Array);
+    }
+    Ok(Value::String(text.to_string()))
+}
+
+/// The parameters: the pipeline options given, as an options object for
+/// [`Params::from_options`].
+fn params_from(pipeline: &PipelineArgs, sub: Option<&ArgMatches>) -> Result<Params> {
+    let mut options = Map::new();
+    if let Some(p) = &pipeline.preset {
+        options.insert("preset".into(), Value::String(p.clone()));
+    }
+    if pipeline.no_expansion {
+        options.insert("expansion".into(), Value::Bool(false));
+    }
+    if let Some(m) = sub {
+        for key in Params::keys() {
+            if let Ok(Some(text)) = m.try_get_one::<String>(&key) {
+                options.insert(key.clone(), option_value(&key, text)?);
             }
         }
     }
-    if let Some(s) = args.take_parsed::<u64>("seed")? {
-        p.seed = s;
-    }
-    p.validate()?;
-    Ok(p)
+    Params::from_options(&options)
 }
 
 /// One polygon of the JSON output.
@@ -119,32 +326,19 @@ fn write_or_return(doc: &impl Serialize, out: Option<String>) -> Result<String> 
     }
 }
 
-fn detect_cmd(args: &mut Args) -> Result<String> {
-    let path = args.positional(0, "CLOUD.bin")?;
-    let stride = args.take_parsed::<usize>("stride")?.unwrap_or(4);
-    let params = params_from(args)?;
-    let out = args.take("out");
-    args.finish()?;
-    let values = crate::io::read_bin(Path::new(&path), stride)?;
-    let cloud = Cloud::from_flat(&values, stride)?;
+fn detect_cmd(args: DetectArgs, params: Params) -> Result<String> {
+    let values = crate::io::read_bin(Path::new(&args.cloud), args.stride)?;
+    let cloud = Cloud::from_flat(&values, args.stride)?;
     let found = crate::detect::detect(&cloud, &params)?;
     let doc = PolygonsJson {
         polygons: found.primitives.iter().map(PolygonJson::from).collect(),
         time_ms: found.time_ms,
     };
-    write_or_return(&doc, out)
+    write_or_return(&doc, args.out)
 }
 
-fn replay_cmd(args: &mut Args) -> Result<String> {
-    let dir = args.positional(0, "DIR")?;
-    let mut params = params_from(args)?;
-    if args.flag("no-expansion") {
-        params.expansion = false;
-    }
-    let out = args.take("out");
-    let report_path = args.take("report");
-    args.finish()?;
-    let data = crate::sim::read_dataset(Path::new(&dir))?;
+fn replay_cmd(args: ReplayArgs, params: Params) -> Result<String> {
+    let data = crate::sim::read_dataset(Path::new(&args.dir))?;
     let mut scenario = crate::scenario::Scenario::new(params)?;
     let mut lines = String::new();
     let mut total_ms = 0.0;
@@ -154,7 +348,7 @@ fn replay_cmd(args: &mut Args) -> Result<String> {
         lines.push_str(&serde_json::to_string(&report).map_err(|e| Error::Invalid(e.to_string()))?);
         lines.push('\n');
     }
-    if let Some(path) = report_path {
+    if let Some(path) = args.report {
         std::fs::write(&path, lines).map_err(|e| Error::Io(format!("cannot write {path}: {e}")))?;
     }
     let doc = PolygonsJson {
@@ -165,22 +359,16 @@ fn replay_cmd(args: &mut Args) -> Result<String> {
             .collect(),
         time_ms: total_ms,
     };
-    write_or_return(&doc, out)
+    write_or_return(&doc, args.out)
 }
 
-fn simulate_cmd(args: &mut Args) -> Result<String> {
-    let layout: crate::sim::Layout = args.positional(0, "LAYOUT")?.parse()?;
-    let seed = args.take_parsed::<u64>("seed")?.unwrap_or(1);
-    let scans = args.take_parsed::<usize>("scans")?.unwrap_or(100);
-    let out = args
-        .take("out")
-        .ok_or_else(|| Error::Invalid("simulate needs --out DIR".into()))?;
-    args.finish()?;
+fn simulate_cmd(args: SimulateArgs) -> Result<String> {
+    let layout: crate::sim::Layout = args.layout.parse()?;
     crate::sim::write_dataset(
-        Path::new(&out),
+        Path::new(&args.out),
         layout,
-        seed,
-        scans,
+        args.seed,
+        args.scans,
         &crate::sim::SensorModel::default(),
     )?;
     Ok(String::new())
@@ -196,10 +384,8 @@ struct PredPolygon {
     vertices: Vec<[f64; 3]>,
 }
 
-fn eval_cmd(args: &mut Args) -> Result<String> {
-    let pred_path = args.positional(0, "PRED.json")?;
-    let gt_dir = args.positional(1, "GT_DIR")?;
-    args.finish()?;
+fn eval_cmd(args: EvalArgs) -> Result<String> {
+    let (pred_path, gt_dir) = (args.pred, args.gt_dir);
     let text = std::fs::read_to_string(&pred_path)
         .map_err(|e| Error::Io(format!("cannot read {pred_path}: {e}")))?;
     let doc: PredDoc = serde_json::from_str(&text)

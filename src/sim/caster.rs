@@ -13,10 +13,11 @@
 //! the sensor) covers, or into an "always" list if its footprint contains the
 //! sensor (the road under the car).
 
+use super::builder::{newell, Clutter};
 use super::normal::Ziggurat;
-use super::scene::{newell, Clutter, Scene};
+use super::scene::Scene;
 use super::sensor::{Beams, SensorModel};
-use super::{SurfaceKind, CLUTTER};
+use super::truth::{SurfaceKind, CLUTTER};
 use crate::geometry::polygon::signed_area;
 use crate::geometry::{Frame, Plane};
 use crate::rng::Rng;

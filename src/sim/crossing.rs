@@ -4,10 +4,9 @@
 //! free-standing wall at an odd angle; rows of buildings continue along the
 //! arms. Road B's +y arm ends in a ramp rising at 6° to 10°.
 
+use super::builder::{Builder, Place, Route, DRIVE_LENGTH};
 use super::parts::{self, Building, Row, RowEnd, CURB_HEIGHT};
-use super::scene::{Builder, Place, Route};
-use super::street::DRIVE_LENGTH;
-use super::SurfaceKind;
+use super::truth::SurfaceKind;
 use glam::{DVec2, DVec3};
 
 /// Where the drive starts on road A (it passes the crossing half-way).

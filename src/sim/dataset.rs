@@ -12,12 +12,11 @@
 //!   `normal · x + offset = 0`.
 
 use super::drive::{Drive, DriveOptions};
-use super::{GtPolygon, Layout, SensorModel, SurfaceKind};
+use super::sensor::SensorModel;
+use super::truth::{parse_ground_truth, GroundTruth, Layout};
 use crate::error::{Error, Result};
-use crate::geometry::Polygon3;
 use crate::io;
-use glam::{DMat4, DVec3};
-use serde::{Deserialize, Serialize};
+use glam::DMat4;
 use std::path::{Path, PathBuf};
 
 /// One scan of a dataset on disk.
@@ -31,17 +30,6 @@ pub struct DatasetScan {
     pub labels: Option<Vec<u32>>,
 }
 
-/// The ground truth of a dataset.
-#[derive(Clone, Debug, PartialEq)]
-pub struct GroundTruth {
-    /// Layout name as written (`"street"`, `"crossing"`).
-    pub layout: String,
-    /// Seed of the scene.
-    pub seed: u64,
-    /// Polygons sorted by id; `polygons[i].id == i`.
-    pub polygons: Vec<GtPolygon>,
-}
-
 /// A dataset read back from disk by [`read_dataset`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct Dataset {
@@ -51,45 +39,6 @@ pub struct Dataset {
     pub poses: Vec<DMat4>,
     /// The ground truth, if `ground_truth.json` exists.
     pub ground_truth: Option<GroundTruth>,
-}
-
-#[derive(Serialize, Deserialize)]
-struct GtFile {
-    layout: String,
-    seed: u64,
-    polygons: Vec<GtRecord>,
-}
-
-#[derive(Serialize, Deserialize)]
-struct GtRecord {
-    id: u32,
-    kind: SurfaceKind,
-    normal: [f64; 3],
-    offset: f64,
-    vertices: Vec<[f64; 3]>,
-}
-
-/// The ground-truth JSON text of polygons.
-pub(crate) fn ground_truth_json(layout: &str, seed: u64, polygons: &[GtPolygon]) -> String {
-    let file = GtFile {
-        layout: layout.to_string(),
-        seed,
-        polygons: polygons
-            .iter()
-            .map(|p| {
-                let plane = p.polygon.plane();
-                GtRecord {
-                    id: p.id,
-                    kind: p.kind,
-                    normal: plane.normal.to_array(),
-                    offset: plane.offset,
-                    vertices: p.polygon.vertices().iter().map(|v| v.to_array()).collect(),
-                }
-            })
-            .collect(),
-    };
-    // Serialising plain numbers and strings cannot fail.
-    serde_json::to_string(&file).unwrap_or_default()
 }
 
 fn io_err(path: &Path, what: impl std::fmt::Display) -> Error {
@@ -204,51 +153,5 @@ pub fn read_dataset(dir: &Path) -> Result<Dataset> {
         scans,
         poses,
         ground_truth,
-    })
-}
-
-/// Parse ground-truth JSON (see the module documentation).
-fn parse_ground_truth(text: &str) -> Result<GroundTruth> {
-    let file: GtFile =
-        serde_json::from_str(text).map_err(|e| Error::Invalid(format!("invalid JSON: {e}")))?;
-    let mut polygons = Vec::with_capacity(file.polygons.len());
-    for r in file.polygons {
-        let verts: Vec<DVec3> = r.vertices.iter().map(|&v| DVec3::from_array(v)).collect();
-        let polygon = Polygon3::from_world(&verts).ok_or_else(|| {
-            Error::Invalid(format!(
-                "polygon {} has fewer than 3 vertices, a non-finite vertex or zero area",
-                r.id
-            ))
-        })?;
-        let normal = DVec3::from_array(r.normal);
-        if !(normal.is_finite() && r.offset.is_finite()) || normal.dot(polygon.frame.normal) < 0.5 {
-            return Err(Error::Invalid(format!(
-                "polygon {}: its normal {normal} does not match its vertex order \
-                 (counter-clockwise seen from the normal side)",
-                r.id
-            )));
-        }
-        polygons.push(GtPolygon {
-            id: r.id,
-            kind: r.kind,
-            polygon,
-        });
-    }
-    polygons.sort_by_key(|p| p.id);
-    if let Some((i, p)) = polygons
-        .iter()
-        .enumerate()
-        .find(|(i, p)| p.id as usize != *i)
-    {
-        return Err(Error::Invalid(format!(
-            "polygon ids must be 0 to {} without repeats; found id {} at position {i}",
-            polygons.len().saturating_sub(1),
-            p.id
-        )));
-    }
-    Ok(GroundTruth {
-        layout: file.layout,
-        seed: file.seed,
-        polygons,
     })
 }

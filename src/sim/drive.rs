@@ -3,7 +3,7 @@
 use super::caster::Caster;
 use super::scene::Scene;
 use super::sensor::{Beams, SensorModel};
-use super::Layout;
+use super::truth::Layout;
 use crate::error::{Error, Result};
 use crate::rng::Rng;
 use glam::{DMat4, DVec3, DVec4};

@@ -29,6 +29,7 @@
 //! Datasets on disk (KITTI layout plus labels and ground truth) are written
 //! by [`write_dataset`] and read by [`read_dataset`].
 
+mod builder;
 mod caster;
 mod crossing;
 mod dataset;
@@ -40,170 +41,11 @@ mod sensor;
 mod street;
 #[cfg(test)]
 mod tests;
+mod truth;
 
-pub use dataset::{read_dataset, write_dataset, Dataset, DatasetScan, GroundTruth};
+pub use builder::Clutter;
+pub use dataset::{read_dataset, write_dataset, Dataset, DatasetScan};
 pub use drive::{Drive, DriveOptions, Location, Scan, LOCATION_SCANS};
-pub use scene::{Clutter, Scene};
+pub use scene::Scene;
 pub use sensor::{hdl64_elevations_deg, SensorModel, MAX_RAYS};
-
-use crate::error::{Error, Result};
-use crate::geometry::Polygon3;
-use serde::{Deserialize, Serialize};
-use std::fmt;
-use std::str::FromStr;
-
-/// Label of a point that lies on no ground-truth polygon: poles, trees, and
-/// small planar surfaces that are not ground truth (door reveals, the end
-/// faces of a free-standing wall).
-pub const CLUTTER: u32 = u32::MAX;
-
-/// The procedural scene layouts.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Layout {
-    /// A straight road along +x with raised sidewalks, curbs, a row of
-    /// buildings on each side (recessed doors, stepped rooflines, gaps closed
-    /// by fences), parked cars, poles and trees.
-    Street,
-    /// Two roads crossing at right angles: L-shaped corner buildings, a plaza
-    /// with a free-standing wall at an odd angle, a ramp leading off one arm,
-    /// rows of buildings, parked cars, poles and trees.
-    Crossing,
-}
-
-impl Layout {
-    /// Every layout.
-    pub const ALL: [Layout; 2] = [Layout::Street, Layout::Crossing];
-
-    /// The layout's name: `"street"` or `"crossing"`.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Layout::Street => "street",
-            Layout::Crossing => "crossing",
-        }
-    }
-}
-
-impl fmt::Display for Layout {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.as_str())
-    }
-}
-
-impl FromStr for Layout {
-    type Err = Error;
-
-    /// Parse `"street"` or `"crossing"` (case-insensitive, surrounding blanks
-    /// ignored); anything else is an [`Error::BadOption`] for `layout`.
-    fn from_str(s: &str) -> Result<Self> {
-        let t = s.trim();
-        Layout::ALL
-            .into_iter()
-            .find(|l| l.as_str().eq_ignore_ascii_case(t))
-            .ok_or_else(|| Error::BadOption {
-                key: "layout".into(),
-                reason: format!("unknown layout '{s}', expected 'street' or 'crossing'"),
-            })
-    }
-}
-
-/// What a ground-truth polygon is (serialised in lowercase).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum SurfaceKind {
-    /// Road surface (z = 0), normal up.
-    Road,
-    /// Raised sidewalk top (0.15 m), normal up; it also covers the ground in
-    /// the gaps between buildings and a plaza.
-    Sidewalk,
-    /// Vertical curb face between road and sidewalk, facing the road.
-    Curb,
-    /// Building wall: front facades (facing the road, with a notch for a
-    /// recessed door, possibly a stepped roofline), side walls, roof steps.
-    Facade,
-    /// A door recessed 0.3 m behind its facade.
-    Door,
-    /// Free-standing walls and fences, ramp side walls.
-    Wall,
-    /// A side or the top of a parked car (a box from 0.3 m to about 1.5 m).
-    Vehicle,
-    /// An inclined driving surface, normal up.
-    Ramp,
-}
-
-impl SurfaceKind {
-    /// Every kind.
-    pub const ALL: [SurfaceKind; 8] = [
-        SurfaceKind::Road,
-        SurfaceKind::Sidewalk,
-        SurfaceKind::Curb,
-        SurfaceKind::Facade,
-        SurfaceKind::Door,
-        SurfaceKind::Wall,
-        SurfaceKind::Vehicle,
-        SurfaceKind::Ramp,
-    ];
-
-    /// The lowercase name, as in JSON.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            SurfaceKind::Road => "road",
-            SurfaceKind::Sidewalk => "sidewalk",
-            SurfaceKind::Curb => "curb",
-            SurfaceKind::Facade => "facade",
-            SurfaceKind::Door => "door",
-            SurfaceKind::Wall => "wall",
-            SurfaceKind::Vehicle => "vehicle",
-            SurfaceKind::Ramp => "ramp",
-        }
-    }
-
-    /// Is the surface (nearly) horizontal, facing up?
-    pub fn is_ground(self) -> bool {
-        matches!(
-            self,
-            SurfaceKind::Road | SurfaceKind::Sidewalk | SurfaceKind::Ramp
-        )
-    }
-}
-
-impl fmt::Display for SurfaceKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.as_str())
-    }
-}
-
-impl FromStr for SurfaceKind {
-    type Err = Error;
-
-    /// Parse a lowercase kind name (case-insensitive).
-    fn from_str(s: &str) -> Result<Self> {
-        let t = s.trim();
-        SurfaceKind::ALL
-            .into_iter()
-            .find(|k| k.as_str().eq_ignore_ascii_case(t))
-            .ok_or_else(|| Error::BadOption {
-                key: "kind".into(),
-                reason: format!(
-                    "unknown surface kind '{s}', expected one of road, sidewalk, curb, \
-                     facade, door, wall, vehicle, ramp"
-                ),
-            })
-    }
-}
-
-/// A ground-truth planar polygon of a scene.
-///
-/// The outline is simple and counter-clockwise seen from the normal side, and
-/// the normal faces the open side, where a sensor can see the surface from
-/// (up for road, sidewalk and ramp; towards the road for facades and curbs;
-/// outwards for vehicle boxes and building side walls).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct GtPolygon {
-    /// Dense id, `0..scene.polygons.len()`; the point label of hits on it.
-    pub id: u32,
-    /// What the surface is.
-    pub kind: SurfaceKind,
-    /// The polygon in world coordinates (metres).
-    pub polygon: Polygon3,
-}
+pub use truth::{GroundTruth, GtPolygon, Layout, SurfaceKind, CLUTTER};

@@ -5,8 +5,8 @@
 //! along the curb, `v` points away from the road (the curb is at `v = 0`, the
 //! road at `v < 0`).
 
-use super::scene::{Builder, Place};
-use super::SurfaceKind;
+use super::builder::{Builder, Place};
+use super::truth::SurfaceKind;
 use glam::{DVec2, DVec3};
 
 /// Height of sidewalks above the road, metres.

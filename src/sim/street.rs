@@ -1,13 +1,11 @@
 //! The `street` layout: a straight road along +x with a sidewalk, a curb and
 //! a row of buildings on each side, parked cars, poles and trees.
 
+use super::builder::{Builder, Place, Route, DRIVE_LENGTH};
 use super::parts::{self, Row, RowEnd, CURB_HEIGHT};
-use super::scene::{Builder, Place, Route};
-use super::SurfaceKind;
+use super::truth::SurfaceKind;
 use glam::DVec2;
 
-/// Length of the drive along the road, metres (200 scans at 1 m).
-pub(crate) const DRIVE_LENGTH: f64 = 199.0;
 /// Road beyond each end of the drive, metres (more than the sensor's range).
 const MARGIN: f64 = 125.0;
 
