@@ -2,6 +2,7 @@
 //! randomly seeded and slower). Maps built with it are only ever looked up,
 //! never iterated to produce results, so output does not depend on it.
 
+use crate::geometry::floor_i64;
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 
@@ -63,28 +64,6 @@ pub fn key3(x: i64, y: i64, z: i64) -> u64 {
 #[inline]
 pub fn key2(x: i64, y: i64) -> u64 {
     ((x as u64) & 0xFFFF_FFFF) | ((y as u64) << 32)
-}
-
-/// `floor(x)` as an integer, exact for |x| < 2^63 (saturating beyond, NaN
-/// gives 0). Much cheaper than `libm::floor` on targets without a rounding
-/// instruction (baseline x86_64), and identical on every platform: wasm has
-/// one (`f64.floor`, then a saturating conversion), and uses it.
-#[inline]
-pub fn floor_i64(x: f64) -> i64 {
-    #[cfg(target_arch = "wasm32")]
-    {
-        x.floor() as i64
-    }
-    #[cfg(not(target_arch = "wasm32"))]
-    {
-        let i = x as i64;
-        if (i as f64) > x {
-            // Saturating: `x as i64` already saturated for x below i64::MIN.
-            i.saturating_sub(1)
-        } else {
-            i
-        }
-    }
 }
 
 /// Point indices grouped by cell (compressed rows): the points of cell `c`

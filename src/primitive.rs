@@ -204,8 +204,8 @@ fn normal_consistency(
         .iter()
         .map(|&i| {
             (
-                crate::hash::floor_i64(q[i].x / cell),
-                crate::hash::floor_i64(q[i].y / cell),
+                crate::geometry::floor_i64(q[i].x / cell),
+                crate::geometry::floor_i64(q[i].y / cell),
             )
         })
         .collect();

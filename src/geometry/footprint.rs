@@ -564,8 +564,8 @@ pub struct Region {
 #[inline]
 fn cell_index(p: DVec2, inv: f64) -> (i64, i64) {
     (
-        crate::hash::floor_i64(p.x * inv),
-        crate::hash::floor_i64(p.y * inv),
+        super::numeric::floor_i64(p.x * inv),
+        super::numeric::floor_i64(p.y * inv),
     )
 }
 

@@ -126,6 +126,28 @@ pub(crate) fn heap_sort_by<T: Copy>(
     }
 }
 
+/// `floor(x)` as an integer, exact for |x| < 2^63 (saturating beyond, NaN
+/// gives 0). Much cheaper than `libm::floor` on targets without a rounding
+/// instruction (baseline x86_64), and identical on every platform: wasm has
+/// one (`f64.floor`, then a saturating conversion), and uses it.
+#[inline]
+pub(crate) fn floor_i64(x: f64) -> i64 {
+    #[cfg(target_arch = "wasm32")]
+    {
+        x.floor() as i64
+    }
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        let i = x as i64;
+        if (i as f64) > x {
+            // Saturating: `x as i64` already saturated for x below i64::MIN.
+            i.saturating_sub(1)
+        } else {
+            i
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::{pull_range, unpull_range};

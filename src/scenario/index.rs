@@ -99,7 +99,7 @@ impl ScanIndex {
         }
         let v = self.voxel;
         let clamp = |x: f64, k: usize| -> i64 {
-            crate::hash::floor_i64(x / v).clamp(self.lo[k], self.hi[k])
+            crate::geometry::floor_i64(x / v).clamp(self.lo[k], self.hi[k])
         };
         let (blo, bhi) = (
             [clamp(lo.x, 0), clamp(lo.y, 1), clamp(lo.z, 2)],
@@ -132,8 +132,8 @@ impl ScanIndex {
                 let rest = d + na[i] * ca + na[j] * cb;
                 let (x0, x1) = ((-rest - slack) / na[k], (-rest + slack) / na[k]);
                 let (x0, x1) = (x0.min(x1), x0.max(x1));
-                let c0 = crate::hash::floor_i64(x0 / v).max(blo[k]);
-                let c1 = crate::hash::floor_i64(x1 / v).min(bhi[k]);
+                let c0 = crate::geometry::floor_i64(x0 / v).max(blo[k]);
+                let c1 = crate::geometry::floor_i64(x1 / v).min(bhi[k]);
                 for c in c0..=c1 {
                     let mut idx = [0i64; 3];
                     idx[i] = a;
