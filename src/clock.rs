@@ -8,6 +8,7 @@ use std::sync::OnceLock;
 static CLOCK: OnceLock<fn() -> f64> = OnceLock::new();
 
 /// Install the millisecond clock (first call wins).
+#[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
 pub fn install(now_ms: fn() -> f64) {
     let _ = CLOCK.set(now_ms);
 }

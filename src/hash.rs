@@ -111,6 +111,7 @@ impl Buckets {
     }
 
     /// Number of cells.
+    #[cfg(test)]
     pub fn cells(&self) -> usize {
         self.start.len().saturating_sub(1)
     }
@@ -276,6 +277,7 @@ impl CellIds {
     }
 
     /// Did the last assignment use the dense array?
+    #[cfg(test)]
     pub fn is_dense(&self) -> bool {
         self.dense
     }

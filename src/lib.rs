@@ -9,27 +9,37 @@
 #![deny(unsafe_code)]
 #![warn(missing_docs)]
 
-// Native only: the command line (and clap) stay out of the wasm build.
-#[cfg(not(target_arch = "wasm32"))]
-pub mod cli;
-pub mod clock;
+// The rooms of the house, in the order of the pipeline. What a user needs
+// is public; the workshop (clocks, hashing, the random generator, the
+// command line's logic, merging, rasters) is private, and what the
+// project's own tests, benches and binary need of it is in `internals`.
 pub mod cloud;
 pub mod detect;
 pub mod error;
 pub mod eval;
 pub mod geometry;
-pub mod hash;
 pub mod io;
-mod merge;
 pub mod mesh;
 pub mod outline;
 pub mod params;
 pub mod primitive;
-pub(crate) mod raster;
-pub mod rng;
 pub mod scenario;
 pub mod sim;
 #[cfg(target_arch = "wasm32")]
 pub mod wasm;
 
+mod clock;
+mod hash;
+mod merge;
+mod raster;
+mod rng;
+
+pub use cloud::Cloud;
+pub use detect::{detect, CascadePolicy, Detection, Detector, NO_PRIMITIVE};
 pub use error::{Error, Result};
+pub use params::{HullKind, Params, SolidityKind, SurfaceParams};
+pub use primitive::Primitive;
+pub use scenario::{MergeEvent, ScanReport, Scenario};
+
+#[doc(hidden)]
+pub mod internals;

@@ -1,9 +1,9 @@
-//! The command-line tool, through `polyscene::cli::run`: help on every
+//! The command-line tool, through `polyscene::internals::cli::run`: help on every
 //! command, every pipeline option on `detect` and `replay`, and errors that
 //! name what was wrong. (Native only, like the command line.)
 #![cfg(not(target_arch = "wasm32"))]
 
-use polyscene::cli::run;
+use polyscene::internals::cli::run;
 use polyscene::params::Params;
 use std::path::PathBuf;
 
@@ -196,5 +196,5 @@ fn bad_files_and_commands_are_errors() {
 fn the_command_line_is_consistent() {
     // Clap's own checks: no two options with one name, conflicts that
     // name existing options.
-    polyscene::cli::command().debug_assert();
+    polyscene::internals::cli::command().debug_assert();
 }

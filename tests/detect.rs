@@ -8,8 +8,8 @@ use polyscene::cloud::Cloud;
 use polyscene::detect::detect;
 use polyscene::geometry::polygon::contains;
 use polyscene::geometry::{Frame, Plane};
+use polyscene::internals::Rng;
 use polyscene::params::{HullKind, Params};
-use polyscene::rng::Rng;
 use polyscene::Error;
 
 fn box_room(rng: &mut Rng) -> Vec<DVec3> {

@@ -199,10 +199,10 @@ fn the_simulator_runs() {
 /// or SSE2 against the same references) and `floor_i64` (`f64.floor` here).
 #[wasm_bindgen_test]
 fn wasm_paths_match_their_references() {
-    use polyscene::detect::kernels::{
+    use polyscene::internals::floor_i64;
+    use polyscene::internals::kernels::{
         inliers, inliers_scalar, msac_scalar, msac_sum, PlaneF32, Points,
     };
-    use polyscene::hash::floor_i64;
     // A pseudo-random slab of points around z = 0.5, with NaNs and -0.
     let mut s = 0x9E37_79B9_7F4A_7C15u64;
     let mut next = |scale: f32| {

@@ -1,12 +1,12 @@
 //! The `polyscene` command-line tool: batch detection, simulation, replay
 //! and evaluation. Run `polyscene --help` for usage. The logic is
-//! `polyscene::cli` (native builds only; on wasm32 this is an empty program).
+//! `polyscene::internals::cli` (native builds only; on wasm32 this is an empty program).
 
 #[cfg(not(target_arch = "wasm32"))]
 fn main() {
     use std::io::Write;
     let args: Vec<String> = std::env::args().skip(1).collect();
-    match polyscene::cli::run(&args) {
+    match polyscene::internals::cli::run(&args) {
         Ok(out) => {
             if !out.is_empty() {
                 // A closed pipe (`| head`) is not an error worth a panic.

@@ -13,6 +13,7 @@ use glam::DVec2;
 
 /// Indices of the points in the largest cluster (ties: the cluster holding
 /// the lowest index), in increasing order. Empty input gives an empty result.
+#[cfg(test)]
 pub fn largest_cluster(points: &[DVec2], tol: f64) -> Vec<u32> {
     let (comp, sizes) = clusters(points, tol);
     let Some(&first) = comp.first() else {
@@ -31,6 +32,7 @@ pub fn largest_cluster(points: &[DVec2], tol: f64) -> Vec<u32> {
 
 /// Cluster label of every point (labels are cell ids of the cluster's root,
 /// so not dense) and the size of each label.
+#[cfg(test)]
 pub fn clusters(points: &[DVec2], tol: f64) -> (Vec<u32>, Vec<u32>) {
     Clusterer::default().clusters(points, tol)
 }

@@ -4,7 +4,7 @@
 //! explained. Which rules run is a [`CascadePolicy`]; the stages of a round
 //! live in `round`, the plane search in [`ransac`].
 
-pub mod cluster;
+pub(crate) mod cluster;
 pub mod kernels;
 mod policy;
 pub mod ransac;

@@ -131,7 +131,7 @@ pub(crate) fn heap_sort_by<T: Copy>(
 /// instruction (baseline x86_64), and identical on every platform: wasm has
 /// one (`f64.floor`, then a saturating conversion), and uses it.
 #[inline]
-pub(crate) fn floor_i64(x: f64) -> i64 {
+pub fn floor_i64(x: f64) -> i64 {
     #[cfg(target_arch = "wasm32")]
     {
         x.floor() as i64

@@ -9,7 +9,7 @@ use polyscene::geometry::polygon::{distance, is_simple, signed_area};
 use polyscene::geometry::Frame;
 use polyscene::params::{HullKind, Params};
 
-use polyscene::rng::Rng;
+use polyscene::internals::Rng;
 
 /// Sample the rectangle `origin + s*u + t*v`, s in [0, a], t in [0, b], on a
 /// grid of `step` with Gaussian noise `sigma` along `u x v`.
