@@ -443,7 +443,7 @@ def render(clouds, res, md_path, figdir):
     A(f"\\* run on the location downsampled to one point per {voxel:g} m voxel (the centroid of each occupied voxel, "
       f"{small_txt} points "
       "for A–E) so that the run stays bounded (ball pivoting, Poisson and DBSCAN on 1.2 M points take minutes each on "
-      "2 cores; one segment_plane + DBSCAN round on the full location A took ~90 s when this report was set up). "
+      "2 cores; one segment_plane + DBSCAN round on the full location A takes ~90 s). "
       "These rows are therefore *not* a like-for-like time comparison with the full-resolution rows; the real scans "
       "are used whole by every method. Open3D and PCL may use both cores (OpenMP); polyscene and pcl.js use one.")
     A("")
@@ -475,7 +475,7 @@ def render(clouds, res, md_path, figdir):
             A("")
         same = [c for c in clouds_present if (c, "gpp2") in nt and nodeby.get(c, {}).get("wasm_gpp2", {}).get("polygons") == nt[(c, "gpp2")]["polygons"]]
         A(f"Native and wasm builds give the same gpp2 polygon count on {len(same)} of {len(clouds_present)} clouds "
-          "(same code, same seed; both builds use scalar math and libm, so they should agree exactly).")
+          "(same code, same seed; the SIMD kernels of both builds keep the scalar reference's order of operations, so they should agree exactly).")
         A("")
 
     # --- target 1 ---
