@@ -20,7 +20,10 @@ fn fnv(h: &mut u64, bytes: &[u8]) {
 fn one_shot(label: &str, cloud: &Cloud, params: &Params) {
     let d = detect(cloud, params).unwrap();
     let mut h = 0xcbf2_9ce4_8422_2325u64;
-    fnv(&mut h, serde_json::to_string(&d.primitives).unwrap().as_bytes());
+    fnv(
+        &mut h,
+        serde_json::to_string(&d.primitives).unwrap().as_bytes(),
+    );
     for l in &d.labels {
         fnv(&mut h, &l.to_le_bytes());
     }
