@@ -1,12 +1,19 @@
 //! Generates the TypeScript declaration of the pipeline options for the JS
 //! package from the `Params` struct in `src/params.rs`: one optional
 //! camelCase key per field, typed from the Rust type, documented with the
-//! field's doc comment (which gives unit and default). `src/wasm.rs` includes
-//! it in the `.d.ts`, so the typings follow the parameters without a second
-//! copy to keep in sync.
+//! field's doc comment (which gives unit and default). `src/wasm/mod.rs`
+//! includes it in the `.d.ts`, so the typings follow the parameters without a
+//! second copy to keep in sync.
+//!
+//! The other interfaces of the `.d.ts` (the results, the options of single
+//! calls) are generated from their Rust structs by `build/ts_interfaces.rs`,
+//! into `interfaces.d.ts`.
 
 use std::fs;
 use std::path::Path;
+
+#[path = "build/ts_interfaces.rs"]
+mod ts_interfaces;
 
 fn main() {
     println!("cargo:rerun-if-changed=src/params.rs");
@@ -20,6 +27,7 @@ fn main() {
     ) {
         panic!("cannot write the generated TypeScript: {e}");
     }
+    ts_interfaces::write(Path::new(&out));
 }
 
 /// `snake_case` to `camelCase`.
