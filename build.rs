@@ -2,11 +2,18 @@
 //! package from the options table `src/params/table.rs` (which the crate
 //! includes too): one optional camelCase key per option, typed from the Rust
 //! type, documented with the option's doc comment (unit and default) and its
-//! range. `src/wasm.rs` includes it in the `.d.ts`, so the typings follow the
+//! range. `src/wasm/mod.rs` includes it in the `.d.ts`, so the typings follow the
 //! parameters without a second copy to keep in sync.
+//!
+//! The other interfaces of the `.d.ts` (the results, the options of single
+//! calls) are generated from their Rust structs by `build/ts_interfaces.rs`,
+//! into `interfaces.d.ts`.
 
 use std::fs;
 use std::path::Path;
+
+#[path = "build/ts_interfaces.rs"]
+mod ts_interfaces;
 
 fn main() {
     println!("cargo:rerun-if-changed=src/params/table.rs");
@@ -19,6 +26,7 @@ fn main() {
     ) {
         panic!("cannot write the generated TypeScript: {e}");
     }
+    ts_interfaces::write(Path::new(&out));
 }
 
 /// `snake_case` to `camelCase`.
@@ -39,14 +47,15 @@ fn camel(name: &str) -> String {
 }
 
 /// The TypeScript type of a `Params` field's Rust type.
-fn ts_type(rust: &str) -> &'static str {
+fn ts_type(rust: &str) -> String {
     match rust {
-        "f64" | "f32" | "usize" | "u64" | "u32" | "i64" | "i32" => "number",
-        "bool" => "boolean",
-        "HullKind" => "\"convex\" | \"concave\"",
-        "SolidityKind" => "\"density\" | \"occupancy\"",
-        "[f64; 3]" => "[number, number, number]",
-        _ => "unknown",
+        "f64" | "f32" | "usize" | "u64" | "u32" | "i64" | "i32" => "number".into(),
+        "bool" => "boolean".into(),
+        // The outline methods and solidity tests, from their enums.
+        "HullKind" => ts_interfaces::string_enum("src/outline/mod.rs", "HullKind"),
+        "SolidityKind" => ts_interfaces::string_enum("src/params/mod.rs", "SolidityKind"),
+        "[f64; 3]" => "[number, number, number]".into(),
+        other => panic!("build.rs: no TypeScript type for the option type {other}"),
     }
 }
 

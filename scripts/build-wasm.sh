@@ -28,7 +28,7 @@ if ! flock -n 9; then
 fi
 
 inputs_hash() {
-  find src build.rs Cargo.toml Cargo.lock .cargo scripts/build-wasm.sh -type f -print0 | sort -z |
+  find src build build.rs Cargo.toml Cargo.lock .cargo scripts/build-wasm.sh -type f -print0 | sort -z |
     xargs -0 sha256sum | sha256sum | cut -d' ' -f1
 }
 

@@ -1,4 +1,4 @@
-//! The binding layer (`src/wasm.rs`) under Node: `wasm-pack test --node --
+//! The binding layer (`src/wasm/`) under Node: `wasm-pack test --node --
 //! --test wasm`. Options parsing, errors as JS `Error`s naming the problem,
 //! a small detection, the scenario's conversions. (The package as a whole is
 //! tested by `node --test tests/js/`.)

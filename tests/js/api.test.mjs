@@ -145,6 +145,40 @@ test("a Scenario far from the origin gives the same polygons, moved", () => {
   for (const x of [a, b, near, far]) x.free();
 });
 
+test("the .d.ts interfaces have the objects' keys and typed arrays (both come from one Rust struct)", () => {
+  const dts = fs.readFileSync(path.join(repoRoot, "pkg/node/polyscene.d.ts"), "utf8");
+  /** key -> type of `interface name` in the .d.ts. */
+  const declared = (name) => {
+    const start = dts.indexOf(`export interface ${name} `);
+    assert.ok(start >= 0, `interface ${name} in the .d.ts`);
+    const block = dts.slice(start, dts.indexOf("\n}", start));
+    return new Map([...block.matchAll(/^\s+(\w+)\??: ([^;]+);$/gm)].map((m) => [m[1], m[2]]));
+  };
+  const check = (name, object) => {
+    const keys = declared(name);
+    assert.deepEqual(Object.keys(object), [...keys.keys()], `keys of ${name}`);
+    for (const [key, type] of keys) {
+      if (/^(Float32|Float64|Uint32)Array$/.test(type)) {
+        assert.equal(object[key]?.constructor?.name, type, `${name}.${key}`);
+      } else if (type === "number") {
+        assert.equal(typeof object[key], "number", `${name}.${key}`);
+      }
+    }
+  };
+  const sim = ps.simulate({ seed: 3 });
+  const scan = sim.scan(0);
+  check("SimulatedScan", scan);
+  check("GroundTruthPolygon", sim.groundTruth()[0]);
+  const s = new ps.Scenario();
+  const report = s.addScan(scan.points, { stride: 4, pose: scan.pose });
+  check("ScanReport", report);
+  check("StageTimes", report.timeMs);
+  check("Polygon", s.polygons()[0]);
+  check("Mesh", s.mesh());
+  for (const m of report.merged) check("MergeEvent", m);
+  for (const x of [s, sim]) x.free();
+});
+
 test("the .d.ts documents every option, with the preset's default", () => {
   const docs = optionDocs();
   const gpp2 = ps.defaultOptions("gpp2");
