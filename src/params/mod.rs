@@ -151,8 +151,11 @@ enum Check {
 }
 
 impl Check {
-    /// Check `v` (numbers as f64); the error names `key`.
-    fn check(self, key: &str, v: f64) -> Result<()> {
+    /// Check `v` (numbers as f64); the error names the option, given by
+    /// its snake_case `name`, by its camelCase key. Not inlined: it is
+    /// called once per option, and the messages' formatting is large.
+    #[inline(never)]
+    fn check(self, name: &str, v: f64) -> Result<()> {
         let reason = match self {
             Check::Any => None,
             Check::Finite => (!v.is_finite()).then(|| "must be finite numbers".to_string()),
@@ -174,50 +177,10 @@ impl Check {
         match reason {
             None => Ok(()),
             Some(reason) => Err(Error::BadOption {
-                key: key.into(),
+                key: camel(name),
                 reason,
             }),
         }
-    }
-}
-
-/// The numbers of a value that [`Check`] looks at.
-trait Checked {
-    fn numbers(&self) -> Vec<f64>;
-}
-impl Checked for f64 {
-    fn numbers(&self) -> Vec<f64> {
-        vec![*self]
-    }
-}
-impl Checked for usize {
-    fn numbers(&self) -> Vec<f64> {
-        vec![*self as f64]
-    }
-}
-impl Checked for u64 {
-    fn numbers(&self) -> Vec<f64> {
-        vec![*self as f64]
-    }
-}
-impl Checked for [f64; 3] {
-    fn numbers(&self) -> Vec<f64> {
-        self.to_vec()
-    }
-}
-impl Checked for bool {
-    fn numbers(&self) -> Vec<f64> {
-        Vec::new()
-    }
-}
-impl Checked for HullKind {
-    fn numbers(&self) -> Vec<f64> {
-        Vec::new()
-    }
-}
-impl Checked for SolidityKind {
-    fn numbers(&self) -> Vec<f64> {
-        Vec::new()
     }
 }
 
@@ -264,17 +227,8 @@ macro_rules! options {
             }
         }
 
-        impl Params {
-            /// Check every option's range; the error names the camelCase key.
-            pub fn validate(&self) -> Result<()> {
-                $(
-                    for v in Checked::numbers(&self.$($path).+) {
-                        $check.check(&camel(stringify!($key)), v)?;
-                    }
-                )*
-                Ok(())
-            }
-        }
+        /// Every option's snake_case name and range, in table order.
+        const CHECKS: &[(&str, Check)] = &[$( (stringify!($key), $check), )*];
     };
 }
 
@@ -358,6 +312,32 @@ impl Params {
         } else {
             &self.other
         }
+    }
+
+    /// Check every option's range ([`CHECKS`], from the options table);
+    /// the error names the camelCase key. The values are read from the
+    /// serde form, where a non-finite number is `null` (and fails every
+    /// numeric range): one loop over a table instead of code per option,
+    /// which keeps the wasm small.
+    pub fn validate(&self) -> Result<()> {
+        use serde_json::Value;
+        let map = self.as_map();
+        for &(name, check) in CHECKS {
+            let value = map.get(&camel(name)).ok_or_else(|| {
+                Error::Invalid(format!("option '{}' missing from the serde form", camel(name)))
+            })?;
+            let number = |v: &Value| v.as_f64().unwrap_or(f64::NAN);
+            match value {
+                Value::Array(items) => {
+                    for v in items {
+                        check.check(name, number(v))?;
+                    }
+                }
+                Value::Number(_) | Value::Null => check.check(name, number(value))?,
+                _ => {}
+            }
+        }
+        Ok(())
     }
 
     /// A preset by name: `"gpp1"` or `"gpp2"`.
