@@ -315,7 +315,7 @@ impl Params {
         }
     }
 
-    /// Check every option's range ([`CHECKS`], from the options table);
+    /// Check every option's range (declared in the options table);
     /// the error names the camelCase key. The values are read from the
     /// serde form, where a non-finite number is `null` (and fails every
     /// numeric range): one loop over a table instead of code per option,
