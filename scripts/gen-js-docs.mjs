@@ -72,6 +72,14 @@ function show(v) {
   return `\`${v}\``;
 }
 
+/** The first sentence of a doc comment, without its unit and default (the
+ * table has columns for them; the .d.ts keeps the whole text). */
+function summary(doc) {
+  const text = doc.replace(/\s*Unit: \S+\./, "").replace(/\s*Range: .*\.$/, "");
+  const first = text.match(/^(.*?[.:])(\s|$)/);
+  return (first ? first[1] : text).replace(/\s*\((m|m\^2|deg|0\.\.1)\)/, "").replace(/[.:]$/, "");
+}
+
 /** The markdown table of every option. */
 export function optionsTable() {
   const { defaultOptions } = pkg();
@@ -79,15 +87,15 @@ export function optionsTable() {
   const gpp1 = defaultOptions("gpp1");
   const esc = (s) => s.replace(/\|/g, "\\|");
   const rows = [
-    "| Key | Type | Unit | Default (gpp2) | gpp1 | Meaning |",
-    "| --- | --- | --- | --- | --- | --- |",
+    "| Key | Type | Unit | Range | Default (gpp2) | gpp1 | Meaning |",
+    "| --- | --- | --- | --- | --- | --- | --- |",
   ];
   for (const [key, { doc, type }] of optionDocs()) {
     const d = key === "preset" ? "gpp2" : gpp2[key];
     const g = key === "preset" ? undefined : JSON.stringify(gpp1[key]) !== JSON.stringify(d) ? gpp1[key] : undefined;
     const t = key === "preset" ? '"gpp1" \\| "gpp2"' : esc(type);
-    const meaning = doc.replace(/\s*Unit: \S+\./, "");
-    rows.push(`| \`${key}\` | ${t} | ${unitOf(doc)} | ${show(d)} | ${show(g)} | ${esc(meaning)} |`);
+    const range = (doc.match(/Range: (.*)\.$/) ?? [])[1] ?? "";
+    rows.push(`| \`${key}\` | ${t} | ${unitOf(doc)} | ${esc(range)} | ${show(d)} | ${show(g)} | ${esc(summary(doc))} |`);
   }
   return rows.join("\n");
 }
