@@ -12,8 +12,12 @@
 use std::fs;
 use std::path::Path;
 
+#[path = "src/params/shared.rs"]
+mod shared;
 #[path = "build/ts_interfaces.rs"]
 mod ts_interfaces;
+
+use shared::{camel, Check};
 
 fn main() {
     println!("cargo:rerun-if-changed=src/params/table.rs");
@@ -29,23 +33,6 @@ fn main() {
     ts_interfaces::write(Path::new(&out));
 }
 
-/// `snake_case` to `camelCase`.
-fn camel(name: &str) -> String {
-    let mut out = String::new();
-    let mut upper = false;
-    for c in name.chars() {
-        if c == '_' {
-            upper = true;
-        } else if upper {
-            out.extend(c.to_uppercase());
-            upper = false;
-        } else {
-            out.push(c);
-        }
-    }
-    out
-}
-
 /// The TypeScript type of a `Params` field's Rust type.
 fn ts_type(rust: &str) -> String {
     match rust {
@@ -56,40 +43,6 @@ fn ts_type(rust: &str) -> String {
         "SolidityKind" => ts_interfaces::string_enum("src/params/mod.rs", "SolidityKind"),
         "[f64; 3]" => "[number, number, number]".into(),
         other => panic!("build.rs: no TypeScript type for the option type {other}"),
-    }
-}
-
-/// An option's valid range, as `src/params/table.rs` declares it (the same
-/// variants as `Check` in `src/params/mod.rs`, which enforces them; here
-/// they are only printed).
-#[allow(dead_code)]
-#[derive(Clone, Copy)]
-enum Check {
-    Any,
-    Finite,
-    Positive(f64),
-    Between(f64, f64),
-    NonNegative,
-    Fraction,
-    Open01,
-    Count(usize, usize),
-    AtLeastOne,
-}
-
-impl Check {
-    /// The range in words, or `None` when any value of the type is valid.
-    fn describe(self) -> Option<String> {
-        Some(match self {
-            Check::Any => return None,
-            Check::Finite => "finite numbers".into(),
-            Check::Positive(max) => format!("(0, {max}]"),
-            Check::Between(lo, hi) => format!("[{lo}, {hi}]"),
-            Check::NonNegative => ">= 0".into(),
-            Check::Fraction => "[0, 1]".into(),
-            Check::Open01 => "(0, 1)".into(),
-            Check::Count(lo, hi) => format!("integer in [{lo}, {hi}]"),
-            Check::AtLeastOne => "integer >= 1".into(),
-        })
     }
 }
 

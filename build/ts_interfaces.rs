@@ -225,23 +225,6 @@ fn clean(line: &str) -> String {
     s
 }
 
-/// `snake_case` to `camelCase`.
-fn camel_case(name: &str) -> String {
-    let mut out = String::new();
-    let mut upper = false;
-    for c in name.chars() {
-        if c == '_' {
-            upper = true;
-        } else if upper {
-            out.extend(c.to_uppercase());
-            upper = false;
-        } else {
-            out.push(c);
-        }
-    }
-    out
-}
-
 /// A variant name as serde writes it under `rename_all` (`None`: as is).
 fn rename(name: &str, rule: Option<&str>) -> String {
     match rule {
@@ -406,7 +389,7 @@ fn interfaces_ts(
                 .attrs
                 .iter()
                 .find_map(|a| a.split_once("rename = \"")?.1.split('"').next())
-                .map_or_else(|| camel_case(name), str::to_string);
+                .map_or_else(|| crate::shared::camel(name), str::to_string);
             let optional = i.optional || ty.starts_with("Option<");
             jsdoc(&mut body, "  ", &item.doc);
             body.push_str(&format!(

@@ -148,6 +148,18 @@ pub fn floor_i64(x: f64) -> i64 {
     }
 }
 
+/// The bounding box (low, high corners) of `pts`; infinite corners for
+/// none.
+pub(crate) fn bounds(pts: &[glam::DVec3]) -> (glam::DVec3, glam::DVec3) {
+    let mut lo = glam::DVec3::splat(f64::INFINITY);
+    let mut hi = glam::DVec3::splat(f64::NEG_INFINITY);
+    for &p in pts {
+        lo = lo.min(p);
+        hi = hi.max(p);
+    }
+    (lo, hi)
+}
+
 #[cfg(test)]
 mod tests {
     use super::{pull_range, unpull_range};

@@ -14,6 +14,7 @@
 pub(crate) mod points;
 pub(crate) mod stats;
 
+use crate::geometry::bounds;
 use crate::geometry::polygon::rings_within;
 use crate::params::Params;
 use crate::primitive::Primitive;
@@ -75,14 +76,4 @@ pub fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
     // The outlines, both in a's frame: touching or overlapping?
     let b_in_a: Vec<DVec2> = bv.iter().map(|&v| a.frame.to_local(v)).collect();
     rings_within(&a.outline, &b_in_a, params.merge_gap)
-}
-
-fn bounds(pts: &[DVec3]) -> (DVec3, DVec3) {
-    let mut lo = DVec3::splat(f64::INFINITY);
-    let mut hi = DVec3::splat(f64::NEG_INFINITY);
-    for &p in pts {
-        lo = lo.min(p);
-        hi = hi.max(p);
-    }
-    (lo, hi)
 }

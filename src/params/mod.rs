@@ -25,6 +25,9 @@
 use crate::error::{Error, Result};
 pub use crate::outline::HullKind;
 use serde::{Deserialize, Serialize};
+use shared::{camel, Check};
+
+mod shared;
 
 /// How "solidity", the paper's second acceptance test, is measured.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -126,30 +129,6 @@ pub struct Params {
     pub merge_gap: f64,
 }
 
-/// The valid range of an option, checked by [`Params::validate`] and shown
-/// in its documentation.
-#[derive(Clone, Copy, Debug)]
-enum Check {
-    /// Any value of the type.
-    Any,
-    /// A finite number (every element of an array).
-    Finite,
-    /// A finite number in (0, max].
-    Positive(f64),
-    /// A finite number in [lo, hi].
-    Between(f64, f64),
-    /// A finite number >= 0.
-    NonNegative,
-    /// A finite number in [0, 1].
-    Fraction,
-    /// A finite number in (0, 1).
-    Open01,
-    /// An integer in [lo, hi].
-    Count(usize, usize),
-    /// An integer >= 1.
-    AtLeastOne,
-}
-
 impl Check {
     /// Check `v` (numbers as f64); the error names the option, given by
     /// its snake_case `name`, by its camelCase key. Not inlined: it is
@@ -182,24 +161,6 @@ impl Check {
             }),
         }
     }
-}
-
-/// `snake_case` to `camelCase`. ASCII only: option names are ASCII, and
-/// the Unicode case tables would add 14 KB to the wasm.
-fn camel(name: &str) -> String {
-    let mut out = String::with_capacity(name.len());
-    let mut upper = false;
-    for c in name.chars() {
-        if c == '_' {
-            upper = true;
-        } else if upper {
-            out.push(c.to_ascii_uppercase());
-            upper = false;
-        } else {
-            out.push(c);
-        }
-    }
-    out
 }
 
 /// From the options table: the flat serde form of [`Params`] (`Wire`, the

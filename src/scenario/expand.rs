@@ -24,8 +24,8 @@
 use super::index::ScanIndex;
 use crate::cloud::Cloud;
 use crate::detect::cluster::Clusterer;
-use crate::geometry::convex_hull;
 use crate::geometry::mask::{GrownMask, Zone};
+use crate::geometry::{bounds, convex_hull};
 use crate::params::Params;
 use crate::primitive::Primitive;
 use glam::{DVec2, DVec3};
@@ -239,14 +239,4 @@ fn grow(
         }
     }
     (taken, inner, outside)
-}
-
-fn bounds(pts: &[DVec3]) -> (DVec3, DVec3) {
-    let mut lo = DVec3::splat(f64::INFINITY);
-    let mut hi = DVec3::splat(f64::NEG_INFINITY);
-    for &p in pts {
-        lo = lo.min(p);
-        hi = hi.max(p);
-    }
-    (lo, hi)
 }
