@@ -42,6 +42,7 @@ fn ts_type(rust: &str) -> String {
         "HullKind" => ts_interfaces::string_enum("src/outline/mod.rs", "HullKind"),
         "SolidityKind" => ts_interfaces::string_enum("src/params/mod.rs", "SolidityKind"),
         "[f64; 3]" => "[number, number, number]".into(),
+        "Option<[f64; 3]>" => "[number, number, number] | null".into(),
         other => panic!("build.rs: no TypeScript type for the option type {other}"),
     }
 }

@@ -35,7 +35,7 @@ fn bench(c: &mut Criterion) {
     g.sample_size(10);
     for (name, preset) in [("gpp1", Params::gpp1()), ("gpp2", Params::gpp2())] {
         let p = Params {
-            viewpoint: scan_view,
+            viewpoint: Some(scan_view),
             ..preset.clone()
         };
         g.bench_function(
@@ -43,7 +43,7 @@ fn bench(c: &mut Criterion) {
             |b| b.iter(|| black_box(detect(&scan_cloud, &p).unwrap().primitives.len())),
         );
         let p = Params {
-            viewpoint: mean.to_array(),
+            viewpoint: Some(mean.to_array()),
             ..preset.clone()
         };
         g.bench_function(

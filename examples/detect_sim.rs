@@ -9,7 +9,7 @@ use polyscene::sim::{Drive, DriveOptions, Layout, SensorModel};
 /// polygon and round counts of that run.
 fn time(label: &str, cloud: &Cloud, viewpoint: glam::DVec3, runs: usize) {
     let p = Params {
-        viewpoint: viewpoint.to_array(),
+        viewpoint: Some(viewpoint.to_array()),
         ..Params::gpp2()
     };
     let mut t: Vec<_> = (0..runs)

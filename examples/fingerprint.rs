@@ -73,7 +73,7 @@ fn main() {
     for (name, base) in [("gpp2", Params::gpp2()), ("gpp1", Params::gpp1())] {
         for hull in [HullKind::Concave, HullKind::Convex] {
             let p = Params {
-                viewpoint: vp,
+                viewpoint: Some(vp),
                 hull,
                 ..base.clone()
             };
@@ -92,7 +92,7 @@ fn main() {
             / loc.poses.len() as f64;
         for hull in [HullKind::Concave, HullKind::Convex] {
             let p = Params {
-                viewpoint: mean.to_array(),
+                viewpoint: Some(mean.to_array()),
                 hull,
                 ..Params::gpp2()
             };

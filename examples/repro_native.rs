@@ -215,7 +215,7 @@ fn variant_params(name: &str, viewpoint: [f64; 3]) -> Res<Params> {
         },
         o => return Err(format!("unknown variant {o}").into()),
     };
-    p.viewpoint = viewpoint;
+    p.viewpoint = Some(viewpoint);
     Ok(p)
 }
 

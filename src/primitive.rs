@@ -2,6 +2,7 @@
 //! running statistics and an occupancy footprint, plus the "shaping" step
 //! that turns a support set into one (PCA refit, outline, area, solidity).
 
+use crate::geometry::floor::GroundRule;
 use crate::geometry::plane::{robust_fit, RobustFit};
 use crate::geometry::polygon::signed_area;
 use crate::geometry::{convex_hull, Footprint, Frame, Moments, Plane, Polygon3};
@@ -256,6 +257,7 @@ pub(crate) fn shape(
     pts: &[Vec3],
     params: &Params,
     viewpoint: DVec3,
+    ground: GroundRule,
     ring_gaps: bool,
 ) -> Option<Shaped> {
     // World coordinates, once: every pass below reads them.
@@ -273,7 +275,7 @@ pub(crate) fn shape(
     let plane = fit.oriented(viewpoint);
     // Ground: near-horizontal, well below the sensor (then, oriented
     // towards the sensor, facing up).
-    let ground = plane.is_ground_below(viewpoint, libm::cos(tilt), params.ground_depth);
+    let ground = ground.of_support(&plane, viewpoint, pts, libm::cos(tilt), params.ground_depth);
     let frame = Frame::on_plane(&plane, moments.mean());
     let surface = params.surface(ground);
     // Support is what lies within the inlier distance of the final plane.

@@ -198,3 +198,53 @@ fn the_command_line_is_consistent() {
     // name existing options.
     polyscene::internals::cli::command().debug_assert();
 }
+
+/// `--poses` makes the mean position of the poses the viewpoint: the same
+/// polygons as `--viewpoint` at that mean; a bad poses file is an error
+/// naming it, and both options together are refused.
+#[test]
+fn poses_give_the_viewpoint_of_an_accumulated_cloud() {
+    let dir = TempDir::new("poses");
+    let cloud = write_cloud(&dir);
+    let poses = dir.0.join("poses.txt");
+    std::fs::write(
+        &poses,
+        "1 0 0 -1 0 1 0 0 0 0 1 0.1\n1 0 0 1 0 1 0 0 0 0 1 -0.1\n",
+    )
+    .unwrap();
+    let poses = poses.to_string_lossy().into_owned();
+    let by_poses = run(&args(&["detect", &cloud, "--poses", &poses])).unwrap();
+    let by_viewpoint = run(&args(&["detect", &cloud, "--viewpoint", "0,0,0"])).unwrap();
+    let strip = |s: &str| {
+        let mut v: serde_json::Value = serde_json::from_str(s).unwrap();
+        v["timeMs"] = serde_json::Value::Null;
+        v
+    };
+    assert_eq!(strip(&by_poses), strip(&by_viewpoint));
+    assert!(polygon_count(&by_poses) >= 2);
+    let moved = run(&args(&["detect", &cloud, "--viewpoint", "30,0,-1.8"])).unwrap();
+    assert_ne!(
+        strip(&moved),
+        strip(&by_poses),
+        "the viewpoint matters here"
+    );
+    let bad = dir.0.join("bad.txt");
+    std::fs::write(&bad, "1 0 0\n").unwrap();
+    let e = run(&args(&[
+        "detect",
+        &cloud,
+        "--poses",
+        &bad.to_string_lossy(),
+    ]))
+    .unwrap_err();
+    assert!(e.to_string().contains("bad.txt"), "{e}");
+    assert!(run(&args(&[
+        "detect",
+        &cloud,
+        "--poses",
+        &poses,
+        "--viewpoint",
+        "0,0,0"
+    ]))
+    .is_err());
+}

@@ -168,7 +168,7 @@ fn drive_through(layout: Layout) {
     // of a round's plane judged, pieces merged), the strongest baseline.
     let one_shot = |max_rejections: usize, paper: bool| {
         let params = Params {
-            viewpoint: mean_pose.to_array(),
+            viewpoint: Some(mean_pose.to_array()),
             max_rejections,
             ..Params::gpp2()
         };

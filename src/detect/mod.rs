@@ -12,11 +12,12 @@ mod round;
 mod viewpoint;
 
 pub use crate::primitive::NO_PRIMITIVE;
-pub use policy::CascadePolicy;
+pub use policy::{CascadePolicy, GroundBy};
 
 use crate::clock;
 use crate::cloud::Cloud;
 use crate::error::Result;
+use crate::geometry::floor::{FloorGrid, GroundRule};
 use crate::params::Params;
 use crate::primitive::Primitive;
 use crate::rng::Rng;
@@ -61,9 +62,15 @@ pub struct Detection {
 }
 
 /// Detect planar polygons in a world-frame cloud seen from
-/// `params.viewpoint` (the sensor position; the origin for a scan in its own
-/// frame). Normals of non-horizontal planes point towards the viewpoint,
-/// near-horizontal ones up.
+/// `params.viewpoint` (the sensor position), if given. Without one, the
+/// origin is taken for the sensor when one could have stood there (0.3 m
+/// to 5 m above the cloud's floor within 10 m: a scan in its own frame);
+/// otherwise (a map, a tile, scans accumulated from many poses) the cloud
+/// is seen from nowhere: the rules that need a viewpoint are off
+/// ([`CascadePolicy::without_viewpoint`]) and ground is decided from the
+/// cloud's local floor. Normals of non-horizontal planes point towards the
+/// viewpoint (without one, towards the cloud's centre), near-horizontal
+/// ones up.
 ///
 /// ```
 /// use polyscene::{cloud::Cloud, detect::detect, params::Params};
@@ -76,21 +83,39 @@ pub struct Detection {
 /// }
 /// let cloud = Cloud::from_flat(&pts, 3).unwrap();
 /// // The sensor 1.8 m above the floor's centre.
-/// let params = Params { viewpoint: [5.0, 5.0, 1.8], ..Params::gpp2() };
+/// let params = Params { viewpoint: Some([5.0, 5.0, 1.8]), ..Params::gpp2() };
 /// let found = detect(&cloud, &params).unwrap();
 /// assert_eq!(found.primitives.len(), 1);
 /// assert!((found.primitives[0].area - 99.0).abs() < 3.0);
 /// ```
 pub fn detect(cloud: &Cloud, params: &Params) -> Result<Detection> {
     params.validate()?;
-    let viewpoint = DVec3::from_array(params.viewpoint);
-    Ok(
-        Detector::new(params, CascadePolicy::one_shot()).run(
-            &cloud.points,
-            cloud.origin,
-            viewpoint,
-        ),
-    )
+    let policy = CascadePolicy::one_shot();
+    if let Some(v) = params.viewpoint {
+        let det = Detector::new(params, policy);
+        return Ok(det.run(&cloud.points, cloud.origin, DVec3::from_array(v)));
+    }
+    let floor = FloorGrid::new(&cloud.points);
+    let det = if floor.could_be_sensor(-cloud.origin) {
+        Detector::new(params, policy)
+    } else {
+        Detector::new(params, policy.without_viewpoint())
+    };
+    let viewpoint = if det.policy.ground == GroundBy::LocalFloor {
+        // Seen from nowhere: normals face a point high above the centre.
+        let n = cloud.points.len().max(1) as f64;
+        let mean = cloud.points.iter().map(|p| p.as_dvec3()).sum::<DVec3>() / n;
+        cloud.origin + mean + DVec3::new(0.0, 0.0, 1e4)
+    } else {
+        DVec3::ZERO
+    };
+    Ok(det.run_with_floor(
+        &cloud.points,
+        cloud.origin,
+        viewpoint,
+        Rng::new(params.seed),
+        Some(&floor),
+    ))
 }
 
 /// The detection cascade: parameters (validated by the caller) and the
@@ -121,8 +146,30 @@ impl<'p> Detector<'p> {
         viewpoint: DVec3,
         rng: Rng,
     ) -> Detection {
+        self.run_with_floor(pts, origin, viewpoint, rng, None)
+    }
+
+    /// [`Detector::run_with_rng`] with the floor of `pts`, when the caller
+    /// has it (built here when the policy needs it and none is given).
+    fn run_with_floor(
+        &self,
+        pts: &[Vec3],
+        origin: DVec3,
+        viewpoint: DVec3,
+        rng: Rng,
+        floor: Option<&FloorGrid>,
+    ) -> Detection {
         let (p, policy) = (self.params, &self.policy);
         let t0 = clock::now_ms();
+        let own_floor;
+        let ground = match (policy.ground, floor) {
+            (GroundBy::Viewpoint, _) => GroundRule::BelowViewpoint,
+            (GroundBy::LocalFloor, Some(f)) => GroundRule::LocalFloor(f),
+            (GroundBy::LocalFloor, None) => {
+                own_floor = FloorGrid::new(pts);
+                GroundRule::LocalFloor(&own_floor)
+            }
+        };
         let local_viewpoint = viewpoint - origin;
         let mut pool = PlanePool::new(
             pts,
@@ -156,7 +203,7 @@ impl<'p> Detector<'p> {
                 ..CascadeStep::default()
             };
             // 1. RANSAC: the plane with the largest consensus, or stop.
-            let Some((plane, inliers, coords)) = pool.best_plane(p, local_viewpoint) else {
+            let Some((plane, inliers, coords)) = pool.best_plane(p, local_viewpoint, ground) else {
                 break;
             };
             step.inliers = inliers.len();
@@ -179,7 +226,7 @@ impl<'p> Detector<'p> {
                         break;
                     }
                     // 4-5. Refit, outline and judge.
-                    let judged = round::judge(support_pts, origin, viewpoint, p, policy);
+                    let judged = round::judge(support_pts, origin, viewpoint, ground, p, policy);
                     if k == 0 {
                         step.area = judged.shaped.as_ref().map_or(0.0, |s| s.primitive.area);
                     }

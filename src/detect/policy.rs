@@ -34,6 +34,11 @@ pub struct CascadePolicy {
     /// not only the largest: one plane often holds several surfaces (the
     /// sides of cars parked in a row, the facades along a street).
     pub every_cluster: bool,
+    /// Candidates whose plane passes through the viewpoint, away from it,
+    /// are rejected as laser rings (see `seen_edge_on`).
+    pub reject_edge_on_candidates: bool,
+    /// What tells ground from other near-horizontal planes.
+    pub ground: GroundBy,
     /// A final pass merges the pieces of one surface that different rounds
     /// or clusters found (with outlines that can merge, see
     /// [`HullKind`](crate::params::HullKind)).
@@ -50,7 +55,23 @@ impl CascadePolicy {
             range_pulled_ground: true,
             bridge_ring_gaps: true,
             every_cluster: true,
+            reject_edge_on_candidates: true,
+            ground: GroundBy::Viewpoint,
             merge_pieces: true,
+        }
+    }
+
+    /// The same rules for a cloud seen from no known position (a map, a
+    /// tile): none of the rules that need the viewpoint, and ground decided
+    /// from the cloud's local floor.
+    pub const fn without_viewpoint(self) -> Self {
+        CascadePolicy {
+            skip_edge_on_hypotheses: false,
+            range_pulled_ground: false,
+            bridge_ring_gaps: false,
+            reject_edge_on_candidates: false,
+            ground: GroundBy::LocalFloor,
+            ..self
         }
     }
 
@@ -69,9 +90,21 @@ impl CascadePolicy {
             range_pulled_ground: false,
             bridge_ring_gaps: false,
             every_cluster: false,
+            reject_edge_on_candidates: true,
+            ground: GroundBy::Viewpoint,
             merge_pieces: false,
         }
     }
+}
+
+/// What tells ground from other near-horizontal planes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GroundBy {
+    /// At least `groundDepth` below the viewpoint (a sensor on a vehicle).
+    Viewpoint,
+    /// On the cloud's local floor: the lowest points of each 4 m column,
+    /// and up to 0.5 m above them (a curb, a sidewalk, a ramp's rise).
+    LocalFloor,
 }
 
 impl Default for CascadePolicy {

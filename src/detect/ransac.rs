@@ -52,6 +52,7 @@
 //! `Params::max_work`.
 
 use super::kernels::{self, PlaneF32};
+use crate::geometry::floor::GroundRule;
 use crate::geometry::plane::robust_fit;
 use crate::geometry::Plane;
 use crate::hash::Buckets;
@@ -389,12 +390,14 @@ impl PlanePool {
     /// The plane with the largest consensus among the remaining points, its
     /// inliers (positions, in voxel order) and their coordinates, or `None`
     /// when no plane has `min_inliers`.
-    /// `viewpoint` is the sensor in local coordinates: horizontal planes at
-    /// least `ground_depth` below it are counted with the ground distance.
-    pub fn best_plane(
+    /// `viewpoint` is the sensor in local coordinates; `ground` tells which
+    /// planes are counted with the ground distance (judged where each
+    /// hypothesis was drawn).
+    pub(crate) fn best_plane(
         &mut self,
         params: &Params,
         viewpoint: DVec3,
+        ground: GroundRule,
     ) -> Option<(LocalPlane, Vec<u32>, Vec<Vec3>)> {
         if self.remaining() < params.min_inliers.max(3) {
             return None;
@@ -411,9 +414,14 @@ impl PlanePool {
         // Prefixes run over the pool arrays, dead (NaN) entries included.
         let n = self.ridx.len();
         let tilt_cos = libm::cos(params.ground_max_tilt.to_radians());
-        let plane_for = |normal: DVec3, offset: f64| {
-            let ground =
-                Plane { normal, offset }.is_ground_below(viewpoint, tilt_cos, params.ground_depth);
+        let plane_for = |normal: DVec3, offset: f64, at: DVec3| {
+            let ground = ground.at_point(
+                &Plane { normal, offset },
+                viewpoint,
+                at,
+                tilt_cos,
+                params.ground_depth,
+            );
             LocalPlane {
                 normal,
                 offset,
@@ -422,8 +430,8 @@ impl PlanePool {
             }
         };
         let mut k = n.min(START_K);
-        let best = loop {
-            let mut best: Option<(LocalPlane, f64)> = None;
+        let (best, best_at) = loop {
+            let mut best: Option<(LocalPlane, f64, DVec3)> = None;
             let budget = self.hypothesis_budget(params);
             let mut needed = budget;
             let (mut t, mut attempts) = (0, 0);
@@ -432,7 +440,8 @@ impl PlanePool {
                 let Some((normal, offset, cell)) = self.sample() else {
                     continue;
                 };
-                let plane = plane_for(normal, offset);
+                let at = self.cell_box[cell].0;
+                let plane = plane_for(normal, offset, at);
                 if self.seen_edge_on(&plane, viewpoint, params) {
                     continue;
                 }
@@ -445,7 +454,7 @@ impl PlanePool {
                 self.scored += 1;
                 let score = self.score_prefix(&plane, k, best.map_or(0.0, |b| b.1));
                 if best.is_none_or(|b| score > b.1) {
-                    best = Some((plane, score));
+                    best = Some((plane, score, at));
                     let w = score / k as f64;
                     needed = hypotheses_needed(w * 0.5, params.confidence);
                 }
@@ -455,7 +464,7 @@ impl PlanePool {
                 k = n.min(k * 4);
                 continue;
             }
-            break best.0;
+            break (best.0, best.2);
         };
         // Local optimisation on a random subsample (a prefix of the shuffled
         // pool: at most LO_SAMPLE points), then one count on all points with
@@ -465,7 +474,7 @@ impl PlanePool {
         let mut plane = best;
         if sample.len() >= 3 {
             if let Some((normal, offset)) = self.refit(&sample) {
-                let refit = plane_for(normal, offset);
+                let refit = plane_for(normal, offset, best_at);
                 // Keep the refit when it scores at least as well on the
                 // subsample, both scored with the hypothesis's threshold.
                 self.work += 2 * lo_k as u64;
@@ -859,7 +868,11 @@ mod tests {
             if reject {
                 pool = pool.reject_slivers();
             }
-            pool.best_plane(&params, DVec3::new(5.0, 5.0, 20.0));
+            pool.best_plane(
+                &params,
+                DVec3::new(5.0, 5.0, 20.0),
+                GroundRule::BelowViewpoint,
+            );
             assert_eq!(pool.scored, budget as u64, "slivers redrawn: {reject}");
         }
     }

@@ -5,6 +5,7 @@ use super::cluster::Clusterer;
 use super::policy::CascadePolicy;
 use super::ransac::LocalPlane;
 use super::viewpoint::{pull_towards, seen_edge_on};
+use crate::geometry::floor::GroundRule;
 use crate::geometry::{Frame, Plane};
 use crate::params::Params;
 use crate::primitive::{shape, Shaped};
@@ -138,14 +139,22 @@ pub(crate) fn judge(
     support_pts: &[Vec3],
     origin: DVec3,
     viewpoint: DVec3,
+    ground: GroundRule,
     p: &Params,
     policy: &CascadePolicy,
 ) -> Judged {
-    let shaped = shape(origin, support_pts, p, viewpoint, policy.bridge_ring_gaps);
+    let shaped = shape(
+        origin,
+        support_pts,
+        p,
+        viewpoint,
+        ground,
+        policy.bridge_ring_gaps,
+    );
     let accepted = shaped.as_ref().is_some_and(|s| {
         s.primitive.acceptable(p)
             && s.roughness <= p.max_roughness
-            && !seen_edge_on(s, viewpoint, p)
+            && !(policy.reject_edge_on_candidates && seen_edge_on(s, viewpoint, p))
             && s.consistency(origin, support_pts, p) >= p.min_normal_consistency
     });
     Judged { shaped, accepted }

@@ -205,6 +205,7 @@ fn absorb(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::floor::GroundRule;
     use crate::geometry::polygon::distance;
     use crate::primitive::shape;
 
@@ -230,7 +231,7 @@ mod tests {
         let mut prims = Vec::new();
         let mut labels = Vec::new();
         for (id, pts) in patches.iter().enumerate() {
-            let s = shape(DVec3::ZERO, pts, p, view, false).unwrap();
+            let s = shape(DVec3::ZERO, pts, p, view, GroundRule::BelowViewpoint, false).unwrap();
             assert!(s.kept.iter().all(|&k| k));
             let mut prim = s.primitive;
             prim.id = id as u32;

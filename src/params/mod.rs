@@ -79,8 +79,8 @@ pub struct Params {
     pub ground_max_tilt: f64,
     /// `groundDepth` (m).
     pub ground_depth: f64,
-    /// `viewpoint` (world, m).
-    pub viewpoint: [f64; 3],
+    /// `viewpoint` (world, m); `None`: see [`crate::detect()`].
+    pub viewpoint: Option<[f64; 3]>,
     /// `minInliers`.
     pub min_inliers: usize,
     /// `maxHypotheses`.
@@ -137,7 +137,7 @@ impl Check {
     fn check(self, name: &str, v: f64) -> Result<()> {
         let reason = match self {
             Check::Any => None,
-            Check::Finite => (!v.is_finite()).then(|| "must be finite numbers".to_string()),
+            Check::FiniteOrNull => (!v.is_finite()).then(|| "must be finite numbers".to_string()),
             Check::Positive(max) => (!(v.is_finite() && v > 0.0 && v <= max))
                 .then(|| format!("must be a number in (0, {max}], got {v}")),
             Check::Between(lo, hi) => (!(v.is_finite() && (lo..=hi).contains(&v)))
@@ -230,7 +230,7 @@ impl Params {
             },
             ground_max_tilt: 15.0,
             ground_depth: 1.3,
-            viewpoint: [0.0; 3],
+            viewpoint: None,
             min_inliers: 150,
             max_hypotheses: 200,
             confidence: 0.995,
@@ -298,6 +298,7 @@ impl Params {
                         check.check(name, number(v))?;
                     }
                 }
+                Value::Null if matches!(check, Check::FiniteOrNull) => {}
                 Value::Number(_) | Value::Null => check.check(name, number(value))?,
                 _ => {}
             }
@@ -481,7 +482,7 @@ mod tests {
                 hull: HullKind::Convex,
                 min_area: 3.0,
                 seed: 9,
-                viewpoint: [1.0, 2.5, 3.0],
+                viewpoint: Some([1.0, 2.5, 3.0]),
                 expansion: false,
                 solidity: SolidityKind::Density,
                 ..Params::gpp1()

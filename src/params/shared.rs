@@ -8,8 +8,8 @@
 pub(crate) enum Check {
     /// Any value of the type.
     Any,
-    /// A finite number (every element of an array).
-    Finite,
+    /// Null, or finite numbers (every element of an array).
+    FiniteOrNull,
     /// A finite number in (0, max].
     Positive(f64),
     /// A finite number in [lo, hi].
@@ -32,7 +32,7 @@ impl Check {
     pub(crate) fn describe(self) -> Option<String> {
         Some(match self {
             Check::Any => return None,
-            Check::Finite => "finite numbers".into(),
+            Check::FiniteOrNull => "finite numbers or null".into(),
             Check::Positive(max) => format!("(0, {max}]"),
             Check::Between(lo, hi) => format!("[{lo}, {hi}]"),
             Check::NonNegative => ">= 0".into(),

@@ -22,9 +22,11 @@ options! {
     /// Sensor position for one-shot detection (world, m): normals of
     /// non-horizontal planes point towards it, it decides what is ground,
     /// and a plane through it (seen edge-on: laser rings) is dropped unless
-    /// it reaches within 1 m of it. Default `[0, 0, 0]`: a scan in its own
-    /// sensor frame. The scenario uses each scan's pose instead.
-    viewpoint: [f64; 3] = viewpoint, "m", Check::Finite;
+    /// it reaches within 1 m of it. Default null: the origin when a sensor
+    /// could have stood there (a scan in its own frame), else none (a map:
+    /// ground from the cloud's local floor, no edge-on rules). The scenario
+    /// uses each scan's pose instead.
+    viewpoint: Option<[f64; 3]> = viewpoint, "m", Check::FiniteOrNull;
     /// Fewest inliers a plane needs, and fewest support points a primitive
     /// needs; the cascade stops when the best plane has fewer. gpp2 default
     /// 150, gpp1 400.

@@ -56,6 +56,11 @@ struct DetectArgs {
     /// Values per point: 3 (x, y, z) or 4 (x, y, z, intensity)
     #[arg(long, value_name = "3|4", default_value_t = 4)]
     stride: usize,
+    /// KITTI poses (12 numbers a line, world-from-sensor) of the scans the
+    /// cloud was accumulated from: the viewpoint is their mean position
+    /// (conflicts with --viewpoint)
+    #[arg(long, value_name = "poses.txt", conflicts_with = "viewpoint")]
+    poses: Option<String>,
     #[command(flatten)]
     pipeline: PipelineArgs,
     /// Write the polygons (JSON) to FILE instead of stdout
@@ -326,7 +331,20 @@ fn write_or_return(doc: &impl Serialize, out: Option<String>) -> Result<String> 
     }
 }
 
-fn detect_cmd(args: DetectArgs, params: Params) -> Result<String> {
+fn detect_cmd(args: DetectArgs, mut params: Params) -> Result<String> {
+    if let Some(path) = &args.poses {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| Error::Io(format!("cannot read {path}: {e}")))?;
+        let poses = crate::io::parse_poses(&text).map_err(|e| match e {
+            Error::BadPose(m) => Error::BadPose(format!("{path}: {m}")),
+            other => other,
+        })?;
+        if poses.is_empty() {
+            return Err(Error::BadPose(format!("{path}: no poses")));
+        }
+        let sum: glam::DVec3 = poses.iter().map(|m| m.w_axis.truncate()).sum();
+        params.viewpoint = Some((sum / poses.len() as f64).to_array());
+    }
     let values = crate::io::read_bin(Path::new(&args.cloud), args.stride)?;
     let cloud = Cloud::from_flat(&values, args.stride)?;
     let found = crate::detect::detect(&cloud, &params)?;

@@ -1,0 +1,191 @@
+//! The local floor of a cloud: for detection without a viewpoint, ground is
+//! what lies at the bottom of the cloud where it is, not a fixed depth below
+//! one sensor position. A road, the sidewalks one curb higher, a ramp and a
+//! raised plateau are all ground; a car's roof or bonnet, a table or a low
+//! wall's top stand above the floor around them and are not.
+
+use super::Plane;
+use glam::{DVec3, Vec3};
+use std::collections::HashMap;
+
+/// Side of a floor cell (m): large enough to hold ground points beside
+/// most objects (a car is 1.8 m wide), small enough that a 6 degree ramp
+/// rises less than [`GROUND_RISE`] across one.
+const CELL: f64 = 4.0;
+/// Highest a ground point may stand above its cell's floor (m): a curb and
+/// a sidewalk (0.15-0.2 m), plus the rise of a ramp or hill across a cell.
+pub(crate) const GROUND_RISE: f64 = 0.5;
+/// The floor of a cell is this quantile of its points' heights: the lowest
+/// points, less the odd point below the ground (a reflection, noise).
+const QUANTILE: f64 = 0.02;
+
+/// Floor height per [`CELL`] x [`CELL`] column of the cloud (local
+/// coordinates, z up).
+pub(crate) struct FloorGrid {
+    floor: HashMap<(i64, i64), f64>,
+}
+
+fn key(x: f64, y: f64) -> (i64, i64) {
+    (
+        crate::geometry::floor_i64(x / CELL),
+        crate::geometry::floor_i64(y / CELL),
+    )
+}
+
+impl FloorGrid {
+    /// The floor of `pts` (non-finite points are skipped).
+    pub(crate) fn new(pts: &[Vec3]) -> Self {
+        let mut heights: HashMap<(i64, i64), Vec<f32>> = HashMap::new();
+        for p in pts {
+            if p.is_finite() {
+                heights
+                    .entry(key(p.x as f64, p.y as f64))
+                    .or_default()
+                    .push(p.z);
+            }
+        }
+        let floor = heights
+            .into_iter()
+            .map(|(k, mut z)| {
+                let rank = ((z.len() as f64 * QUANTILE) as usize).min(z.len() - 1);
+                let (_, &mut h, _) = z.select_nth_unstable_by(rank, f32::total_cmp);
+                (k, h as f64)
+            })
+            .collect();
+        FloorGrid { floor }
+    }
+
+    /// The floor under `(x, y)`, if its cell holds points.
+    pub(crate) fn at(&self, x: f64, y: f64) -> Option<f64> {
+        self.floor.get(&key(x, y)).copied()
+    }
+
+    /// Does `p` stand on the floor (at most [`GROUND_RISE`] above it)?
+    pub(crate) fn on_floor(&self, p: DVec3) -> bool {
+        self.at(p.x, p.y).is_some_and(|f| p.z - f <= GROUND_RISE)
+    }
+
+    /// The lowest floor within `radius` (m) of `(x, y)`, horizontally.
+    pub(crate) fn lowest_near(&self, x: f64, y: f64, radius: f64) -> Option<f64> {
+        let r = (radius / CELL).ceil() as i64;
+        let (cx, cy) = key(x, y);
+        let mut lowest: Option<f64> = None;
+        for i in cx - r..=cx + r {
+            for j in cy - r..=cy + r {
+                if let Some(&f) = self.floor.get(&(i, j)) {
+                    lowest = Some(lowest.map_or(f, |l| l.min(f)));
+                }
+            }
+        }
+        lowest
+    }
+
+    /// Could a sensor have stood at `p`: some floor within 10 m of it, and
+    /// `p` between 0.3 m and 5 m above the lowest of it (a LiDAR on a robot,
+    /// a car's roof or a tripod)? A cloud in its sensor's own frame has its
+    /// sensor at the origin; a world-frame map's origin is usually elsewhere,
+    /// or on the ground.
+    pub(crate) fn could_be_sensor(&self, p: DVec3) -> bool {
+        self.lowest_near(p.x, p.y, 10.0)
+            .is_some_and(|f| (0.3..=5.0).contains(&(p.z - f)))
+    }
+}
+
+/// How a plane is told to be ground (ground planes get their own inlier
+/// distance, clustering tolerance and outline radius).
+#[derive(Clone, Copy)]
+pub(crate) enum GroundRule<'g> {
+    /// Near-horizontal and at least `groundDepth` below the viewpoint.
+    BelowViewpoint,
+    /// Near-horizontal and on the cloud's local floor.
+    LocalFloor(&'g FloorGrid),
+}
+
+impl GroundRule<'_> {
+    /// Is `plane` ground, judged where it passes over `at` (a hypothesis,
+    /// drawn near `at`)? `viewpoint` and `at` in the plane's coordinates,
+    /// which are the floor's.
+    pub(crate) fn at_point(
+        &self,
+        plane: &Plane,
+        viewpoint: DVec3,
+        at: DVec3,
+        min_cos: f64,
+        depth: f64,
+    ) -> bool {
+        match self {
+            GroundRule::BelowViewpoint => plane.is_ground_below(viewpoint, min_cos, depth),
+            GroundRule::LocalFloor(grid) => {
+                plane.normal.z.abs() >= min_cos && {
+                    let n = plane.normal;
+                    let z = -(n.x * at.x + n.y * at.y + plane.offset) / n.z;
+                    grid.on_floor(DVec3::new(at.x, at.y, z))
+                }
+            }
+        }
+    }
+
+    /// Is `plane` (world coordinates) ground, judged on its support `pts`
+    /// (local coordinates, the floor's): most of them on the floor?
+    pub(crate) fn of_support(
+        &self,
+        plane: &Plane,
+        viewpoint: DVec3,
+        pts: &[Vec3],
+        min_cos: f64,
+        depth: f64,
+    ) -> bool {
+        match self {
+            GroundRule::BelowViewpoint => plane.is_ground_below(viewpoint, min_cos, depth),
+            GroundRule::LocalFloor(grid) => {
+                plane.normal.z.abs() >= min_cos
+                    && 2 * pts.iter().filter(|p| grid.on_floor(p.as_dvec3())).count() >= pts.len()
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A road at z = 0 over 40 m x 40 m, a sidewalk at 0.15 m beside it, a
+    /// car roof at 1.5 m with its side down to 0.3 m.
+    fn scene() -> Vec<Vec3> {
+        let mut pts = Vec::new();
+        for i in 0..200 {
+            for j in 0..200 {
+                let (x, y) = (i as f32 * 0.2, j as f32 * 0.2);
+                let z = if y > 30.0 { 0.15 } else { 0.0 };
+                pts.push(Vec3::new(x, y, z));
+            }
+        }
+        for i in 0..20 {
+            for j in 0..9 {
+                pts.push(Vec3::new(10.0 + i as f32 * 0.2, 10.0 + j as f32 * 0.2, 1.5));
+            }
+            for k in 0..6 {
+                pts.push(Vec3::new(10.0 + i as f32 * 0.2, 10.0, 0.3 + k as f32 * 0.2));
+            }
+        }
+        pts
+    }
+
+    #[test]
+    fn road_and_sidewalk_are_on_the_floor_a_roof_is_not() {
+        let g = FloorGrid::new(&scene());
+        assert!(g.on_floor(DVec3::new(5.0, 5.0, 0.0)));
+        assert!(g.on_floor(DVec3::new(5.0, 35.0, 0.15)));
+        assert!(!g.on_floor(DVec3::new(11.0, 11.0, 1.5)));
+        assert!(!g.on_floor(DVec3::new(500.0, 5.0, 0.0)), "no floor there");
+    }
+
+    #[test]
+    fn a_sensor_stands_above_the_floor_not_on_it() {
+        let g = FloorGrid::new(&scene());
+        assert!(g.could_be_sensor(DVec3::new(20.0, 20.0, 1.8)));
+        assert!(!g.could_be_sensor(DVec3::new(20.0, 20.0, 0.0)));
+        assert!(!g.could_be_sensor(DVec3::new(20.0, 20.0, 30.0)));
+        assert!(!g.could_be_sensor(DVec3::new(-500.0, 0.0, 1.8)));
+    }
+}
