@@ -29,6 +29,7 @@ pub mod sim;
 pub mod wasm;
 
 mod clock;
+mod floor;
 mod hash;
 mod merge;
 mod raster;

@@ -2,7 +2,7 @@
 //! running statistics and an occupancy footprint, plus the "shaping" step
 //! that turns a support set into one (PCA refit, outline, area, solidity).
 
-use crate::geometry::floor::GroundRule;
+use crate::floor::GroundRule;
 use crate::geometry::plane::{robust_fit, RobustFit};
 use crate::geometry::polygon::signed_area;
 use crate::geometry::{convex_hull, Footprint, Frame, Moments, Plane, Polygon3};

@@ -17,7 +17,7 @@ pub use policy::{CascadePolicy, GroundBy};
 use crate::clock;
 use crate::cloud::Cloud;
 use crate::error::Result;
-use crate::geometry::floor::{FloorGrid, GroundRule};
+use crate::floor::{FloorGrid, GroundRule};
 use crate::params::Params;
 use crate::primitive::Primitive;
 use crate::rng::Rng;

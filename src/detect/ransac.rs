@@ -52,7 +52,7 @@
 //! `Params::max_work`.
 
 use super::kernels::{self, PlaneF32};
-use crate::geometry::floor::GroundRule;
+use crate::floor::GroundRule;
 use crate::geometry::plane::robust_fit;
 use crate::geometry::Plane;
 use crate::hash::Buckets;

@@ -5,7 +5,7 @@ use super::cluster::Clusterer;
 use super::policy::CascadePolicy;
 use super::ransac::LocalPlane;
 use super::viewpoint::{pull_towards, seen_edge_on};
-use crate::geometry::floor::GroundRule;
+use crate::floor::GroundRule;
 use crate::geometry::{Frame, Plane};
 use crate::params::Params;
 use crate::primitive::{shape, Shaped};

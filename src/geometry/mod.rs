@@ -2,7 +2,6 @@
 //! polygon operations, convex hulls, occupancy footprints with concave
 //! outlines, and triangulation.
 
-pub(crate) mod floor;
 pub mod footprint;
 pub mod hull;
 pub mod mask;

@@ -205,7 +205,7 @@ fn absorb(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::floor::GroundRule;
+    use crate::floor::GroundRule;
     use crate::geometry::polygon::distance;
     use crate::primitive::shape;
 

@@ -4,9 +4,9 @@
 //! raised plateau are all ground; a car's roof or bonnet, a table or a low
 //! wall's top stand above the floor around them and are not.
 
-use super::Plane;
+use crate::geometry::Plane;
+use crate::hash::GridMap;
 use glam::{DVec3, Vec3};
-use std::collections::HashMap;
 
 /// Side of a floor cell (m): large enough to hold ground points beside
 /// most objects (a car is 1.8 m wide), small enough that a 6 degree ramp
@@ -15,14 +15,45 @@ const CELL: f64 = 4.0;
 /// Highest a ground point may stand above its cell's floor (m): a curb and
 /// a sidewalk (0.15-0.2 m), plus the rise of a ramp or hill across a cell.
 pub(crate) const GROUND_RISE: f64 = 0.5;
-/// The floor of a cell is this quantile of its points' heights: the lowest
-/// points, less the odd point below the ground (a reflection, noise).
-const QUANTILE: f64 = 0.02;
+/// The floor of a cell is its points' height of this rank from the bottom
+/// (0: the lowest), or of the rank of the lowest 2 % in a cell of fewer than
+/// 400 points: the lowest points, less the odd point below the ground (a
+/// reflection, noise).
+const RANK: usize = 7;
+
+/// The [`RANK`]` + 1` lowest heights of a cell, ascending, and its count.
+#[derive(Clone, Copy)]
+struct Lowest {
+    n: u32,
+    z: [f32; RANK + 1],
+}
+
+impl Lowest {
+    fn push(&mut self, z: f32) {
+        let kept = (self.n as usize).min(RANK + 1);
+        self.n += 1;
+        if kept == RANK + 1 && z >= self.z[RANK] {
+            return;
+        }
+        // Insert in order, dropping the highest when full.
+        let mut i = kept.min(RANK);
+        while i > 0 && self.z[i - 1] > z {
+            self.z[i] = self.z[i - 1];
+            i -= 1;
+        }
+        self.z[i] = z;
+    }
+
+    fn floor(&self) -> f64 {
+        let rank = (self.n as usize / 50).min(RANK);
+        self.z[rank] as f64
+    }
+}
 
 /// Floor height per [`CELL`] x [`CELL`] column of the cloud (local
 /// coordinates, z up).
 pub(crate) struct FloorGrid {
-    floor: HashMap<(i64, i64), f64>,
+    floor: GridMap<(i64, i64), f64>,
 }
 
 fn key(x: f64, y: f64) -> (i64, i64) {
@@ -35,24 +66,21 @@ fn key(x: f64, y: f64) -> (i64, i64) {
 impl FloorGrid {
     /// The floor of `pts` (non-finite points are skipped).
     pub(crate) fn new(pts: &[Vec3]) -> Self {
-        let mut heights: HashMap<(i64, i64), Vec<f32>> = HashMap::new();
+        let mut lowest: GridMap<(i64, i64), Lowest> = GridMap::default();
         for p in pts {
             if p.is_finite() {
-                heights
+                lowest
                     .entry(key(p.x as f64, p.y as f64))
-                    .or_default()
+                    .or_insert(Lowest {
+                        n: 0,
+                        z: [f32::INFINITY; RANK + 1],
+                    })
                     .push(p.z);
             }
         }
-        let floor = heights
-            .into_iter()
-            .map(|(k, mut z)| {
-                let rank = ((z.len() as f64 * QUANTILE) as usize).min(z.len() - 1);
-                let (_, &mut h, _) = z.select_nth_unstable_by(rank, f32::total_cmp);
-                (k, h as f64)
-            })
-            .collect();
-        FloorGrid { floor }
+        FloorGrid {
+            floor: lowest.into_iter().map(|(k, l)| (k, l.floor())).collect(),
+        }
     }
 
     /// The floor under `(x, y)`, if its cell holds points.
@@ -178,6 +206,32 @@ mod tests {
         assert!(g.on_floor(DVec3::new(5.0, 35.0, 0.15)));
         assert!(!g.on_floor(DVec3::new(11.0, 11.0, 1.5)));
         assert!(!g.on_floor(DVec3::new(500.0, 5.0, 0.0)), "no floor there");
+    }
+
+    #[test]
+    fn the_floor_ignores_a_few_points_below_the_ground() {
+        let mut pts = scene();
+        for i in 0..5 {
+            pts.push(Vec3::new(1.0 + i as f32 * 0.1, 1.0, -3.0));
+        }
+        let g = FloorGrid::new(&pts);
+        assert_eq!(g.at(1.0, 1.0), Some(0.0));
+        let mut l = Lowest {
+            n: 0,
+            z: [f32::INFINITY; RANK + 1],
+        };
+        for z in [5.0, 3.0, 4.0, 1.0, 2.0] {
+            l.push(z);
+        }
+        assert_eq!(l.floor(), 1.0, "under 50 points: the lowest");
+        for k in 0..500 {
+            l.push(10.0 + k as f32);
+        }
+        assert_eq!(
+            l.floor(),
+            10.0 + 2.0,
+            "the 8th lowest: 1..5, then 10, 11, 12"
+        );
     }
 
     #[test]
