@@ -15,7 +15,7 @@ pub(crate) mod points;
 pub(crate) mod stats;
 
 use crate::geometry::bounds;
-use crate::geometry::polygon::rings_within;
+use crate::geometry::polygon::{contains, distance, rings_within};
 use crate::params::Params;
 use crate::primitive::Primitive;
 use glam::{DVec2, DVec3};
@@ -31,9 +31,16 @@ pub struct MergeEvent {
 }
 
 /// Should `a` and `b` be one primitive? Their planes within `mergeAngle`,
-/// the smaller one on the larger one's plane (or each centroid on the
-/// other's plane) within `mergeDistance`, and their outlines within
-/// `mergeGap` of each other.
+/// and either
+/// - the smaller one on the larger one's plane (or each centroid on the
+///   other's plane) within `mergeDistance`, and their outlines within
+///   `mergeGap` of each other (pieces of one surface that grew together);
+/// - or the smaller one lying over the larger one (three quarters of its
+///   outline vertices inside the larger's outline, or within `mergeGap` of
+///   it) within the inlier
+///   distance of non-ground planes (`distance`): layers closer than RANSAC
+///   tells planes apart, such as one surface seen again through a pose a
+///   few centimetres off.
 pub fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
     if a.plane.angle_to(&b.plane) > params.merge_angle.to_radians() {
         return false;
@@ -65,13 +72,23 @@ pub fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
     let (ca, cb) = (a.moments.mean(), b.moments.mean());
     let centroids = a.plane.signed_distance(cb).abs() <= params.merge_distance
         && b.plane.signed_distance(ca).abs() <= params.merge_distance;
-    if ms.sqrt() > params.merge_distance && !centroids {
+    let close = ms.sqrt() <= params.merge_distance || centroids;
+    let layered = !close && ms.sqrt() <= params.other.distance;
+    if !close && !layered {
         return false;
     }
     let ((alo, ahi), (blo, bhi)) = (bounds(&av), bounds(&bv));
-    let pad = DVec3::splat(params.merge_gap + params.merge_distance);
+    let pad = DVec3::splat(params.merge_gap + params.merge_distance.max(params.other.distance));
     if (alo - pad).cmpgt(bhi).any() || (blo - pad).cmpgt(ahi).any() {
         return false;
+    }
+    if layered {
+        let inside = small_v
+            .iter()
+            .map(|&v| big.frame.to_local(v))
+            .filter(|&q| contains(&big.outline, q) || distance(&big.outline, q) <= params.merge_gap)
+            .count();
+        return 4 * inside >= 3 * small_v.len();
     }
     // The outlines, both in a's frame: touching or overlapping?
     let b_in_a: Vec<DVec2> = bv.iter().map(|&v| a.frame.to_local(v)).collect();

@@ -315,4 +315,28 @@ mod tests {
         assert!(labels[..a.len()].iter().all(|&l| l == 0));
         assert!(labels[a.len()..].iter().all(|&l| l == 1));
     }
+
+    /// One wall seen twice through poses 9 cm apart: overlapping layers
+    /// closer than the inlier distance are one surface. 15 cm apart (a
+    /// window recessed in a facade) they stay two, and so does a layer
+    /// beside the wall rather than over it (a step, not a layer).
+    #[test]
+    fn overlapping_layers_within_the_inlier_distance_merge() {
+        let p = Params::gpp2();
+        let shifted = |pts: Vec<Vec3>, dy: f32| -> Vec<Vec3> {
+            pts.into_iter()
+                .map(|q| q + Vec3::new(0.0, dy, 0.0))
+                .collect()
+        };
+        let a = patch(0.0, 6.0, 0.0, 0.0);
+        let b = shifted(patch(1.0, 4.0, 0.0, 0.025), 0.09);
+        let (prims, _, _) = two(&a, &b, &p);
+        assert!(mergeable(&prims[0], &prims[1], &p));
+        let c = shifted(patch(1.0, 4.0, 0.0, 0.025), 0.15);
+        let (prims, _, _) = two(&a, &c, &p);
+        assert!(!mergeable(&prims[0], &prims[1], &p));
+        let d = shifted(patch(6.2, 9.0, 0.0, 0.025), 0.09);
+        let (prims, _, _) = two(&a, &d, &p);
+        assert!(!mergeable(&prims[0], &prims[1], &p));
+    }
 }
