@@ -14,7 +14,7 @@
 //!     }
 //! }
 //! let cloud = Cloud::from_flat(&pts, 3).unwrap();
-//! let params = Params { viewpoint: [5.0, 5.0, 1.8], ..Params::gpp2() };
+//! let params = Params { viewpoint: Some([5.0, 5.0, 1.8]), ..Params::gpp2() };
 //! let found = detect(&cloud, &params).unwrap();
 //! let mesh = triangulate(&found.primitives);
 //! assert_eq!(mesh.polygon_ids.len() * 3, mesh.indices.len());

@@ -133,8 +133,9 @@ options! {
     /// Default 8.
     merge_angle: f64 = merge_angle, "deg", Check::Positive(90.0);
     /// Largest RMS distance of the smaller primitive's outline vertices and
-    /// centroid from the larger one's plane for a merge (m); keep it below
-    /// the height of a curb. Default 0.08.
+    /// centroid from the larger one's plane for a merge of pieces that touch
+    /// (m); keep it below the height of a curb. A piece lying over the
+    /// other merges within `distance`. Default 0.08.
     merge_distance: f64 = merge_distance, "m", Check::Positive(100.0);
     /// Outlines closer than this are touching, for a merge (m). Default
     /// 0.3.
