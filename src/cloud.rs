@@ -4,6 +4,21 @@
 use crate::error::{Error, Result};
 use glam::{DMat4, DVec3, Vec3};
 
+/// Largest world coordinate accepted (m): beyond any geodetic frame (the
+/// Earth's radius is 6.4e6 m), and small enough that every derived length,
+/// area and grid index stays finite and exact enough.
+pub const MAX_COORDINATE: f64 = 1e9;
+
+/// The first point whose world coordinates lie beyond [`MAX_COORDINATE`].
+fn check_range(points: impl Iterator<Item = DVec3>) -> Result<()> {
+    for (i, p) in points.enumerate() {
+        if p.abs().max_element() > MAX_COORDINATE {
+            return Err(Error::OutOfRange { point: i });
+        }
+    }
+    Ok(())
+}
+
 /// Check that a flat buffer has a valid stride and finite x, y, z.
 pub fn check_finite(values: &[f32], stride: usize) -> Result<()> {
     if stride != 3 && stride != 4 {
@@ -70,6 +85,7 @@ impl Cloud {
         if let Some(i) = points.iter().position(|p| !p.is_finite()) {
             return Err(Error::NonFinite { point: i });
         }
+        check_range(points.iter().copied())?;
         Ok(Self::around_box_centre(points.iter().copied()))
     }
 
@@ -77,6 +93,7 @@ impl Cloud {
     pub fn from_flat(values: &[f32], stride: usize) -> Result<Self> {
         check_finite(values, stride)?;
         let at = |p: &[f32]| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
+        check_range(values.chunks_exact(stride).map(at))?;
         Ok(Self::around_box_centre(values.chunks_exact(stride).map(at)))
     }
 
@@ -96,14 +113,20 @@ impl Cloud {
     pub fn from_sensor(values: &[f32], stride: usize, pose: &DMat4) -> Result<Self> {
         check_finite(values, stride)?;
         check_rigid(pose)?;
+        if pose.w_axis.truncate().abs().max_element() > MAX_COORDINATE {
+            return Err(Error::BadPose(format!(
+                "its translation lies more than {MAX_COORDINATE:e} m from the world origin"
+            )));
+        }
         let origin = pose.w_axis.truncate().round();
-        let points = values
-            .chunks_exact(stride)
-            .map(|p| {
-                let w = pose.transform_point3(DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
-                (w - origin).as_vec3()
-            })
-            .collect();
+        let mut points = Vec::with_capacity(values.len() / stride);
+        for (i, p) in values.chunks_exact(stride).enumerate() {
+            let w = pose.transform_point3(DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
+            if w.abs().max_element() > MAX_COORDINATE {
+                return Err(Error::OutOfRange { point: i });
+            }
+            points.push((w - origin).as_vec3());
+        }
         Ok(Cloud { origin, points })
     }
 

@@ -21,6 +21,12 @@ pub enum Error {
         /// Index of the point.
         point: usize,
     },
+    /// A point farther than [`MAX_COORDINATE`](crate::cloud::MAX_COORDINATE)
+    /// from the world origin (after its pose, for a scan).
+    OutOfRange {
+        /// Index of the point.
+        point: usize,
+    },
     /// A pose that is not a rigid transform, or of the wrong size.
     BadPose(String),
     /// An option out of range or unknown.
@@ -52,6 +58,12 @@ impl fmt::Display for Error {
             Error::NonFinite { point } => {
                 write!(f, "point {point} has a NaN or infinite coordinate")
             }
+            Error::OutOfRange { point } => write!(
+                f,
+                "point {point} lies more than {:e} m from the world origin (after the \
+                 pose, for a scan); coordinates are metres",
+                crate::cloud::MAX_COORDINATE,
+            ),
             Error::BadPose(why) => write!(f, "invalid pose: {why}"),
             Error::BadOption { key, reason } => write!(f, "option '{key}': {reason}"),
             Error::Io(why) => write!(f, "{why}"),

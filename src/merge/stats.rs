@@ -1,21 +1,25 @@
 //! Merging from running statistics: the scenario's merge after every scan.
 
-use super::{mergeable, MergeEvent};
+use super::{merge_kind, Kind, MergeEvent};
 use crate::params::Params;
 use crate::primitive::Primitive;
 use glam::DVec2;
 
-/// Absorb `b` into `a`.
-fn absorb(a: &mut Primitive, b: &Primitive, params: &Params) {
-    a.moments.merge(&b.moments);
-    let old_normal = a.plane.normal;
-    if let Some((mut plane, _)) = a.moments.fit_plane() {
-        if plane.normal.dot(old_normal) < 0.0 {
-            plane.normal = -plane.normal;
-            plane.offset = -plane.offset;
+/// Absorb `b` into `a`: pieces join statistics and refit; a layer (the
+/// same surface seen through a pose error) adds only its footprint, so
+/// that the error does not move `a`'s plane.
+fn absorb(a: &mut Primitive, b: &Primitive, kind: Kind, params: &Params) {
+    if kind == Kind::Pieces {
+        a.moments.merge(&b.moments);
+        let old_normal = a.plane.normal;
+        if let Some((mut plane, _)) = a.moments.fit_plane() {
+            if plane.normal.dot(old_normal) < 0.0 {
+                plane.normal = -plane.normal;
+                plane.offset = -plane.offset;
+            }
+            a.plane = plane;
+            a.frame = a.frame.realigned(&plane);
         }
-        a.plane = plane;
-        a.frame = a.frame.realigned(&plane);
     }
     let (fa, fb) = (a.frame, b.frame);
     a.footprint
@@ -43,9 +47,10 @@ pub(crate) fn merge_all(
         let Some(ia) = prims.iter().position(|p| p.id == id) else {
             continue;
         };
-        let partner =
-            (0..prims.len()).find(|&j| j != ia && mergeable(&prims[ia], &prims[j], params));
-        let Some(ib) = partner else {
+        let partner = (0..prims.len())
+            .filter(|&j| j != ia)
+            .find_map(|j| Some((j, merge_kind(&prims[ia], &prims[j], params)?)));
+        let Some((ib, kind)) = partner else {
             continue;
         };
         // The older (smaller id) survives.
@@ -55,7 +60,7 @@ pub(crate) fn merge_all(
             (ib, ia)
         };
         let b = prims[gone].clone();
-        absorb(&mut prims[keep], &b, params);
+        absorb(&mut prims[keep], &b, kind, params);
         let kept_id = prims[keep].id;
         events.push(MergeEvent {
             kept: kept_id,
