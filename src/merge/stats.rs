@@ -5,30 +5,48 @@ use crate::params::Params;
 use crate::primitive::Primitive;
 use glam::DVec2;
 
-/// Absorb `b` into `a`: pieces join statistics and refit; a layer (the
-/// same surface seen through a pose error) adds only its footprint, so
-/// that the error does not move `a`'s plane.
+/// Absorb `b` (the newer) into `a`, which keeps its id. Pieces join
+/// statistics and refit. For a layer (one surface seen again through a pose
+/// error) the newer layer's plane and statistics stand for the surface from
+/// now on, so that the map follows the poses as they come and the next
+/// scans grow it; the older footprint joins it.
 fn absorb(a: &mut Primitive, b: &Primitive, kind: Kind, params: &Params) {
-    if kind == Kind::Pieces {
-        a.moments.merge(&b.moments);
-        let old_normal = a.plane.normal;
-        if let Some((mut plane, _)) = a.moments.fit_plane() {
-            if plane.normal.dot(old_normal) < 0.0 {
-                plane.normal = -plane.normal;
-                plane.offset = -plane.offset;
+    let (support, born, last) = (
+        a.support + b.support,
+        a.born_scan.min(b.born_scan),
+        a.last_scan.max(b.last_scan),
+    );
+    // `other` is the primitive whose footprint and outline join `a`'s.
+    let other = match kind {
+        Kind::Pieces => {
+            a.moments.merge(&b.moments);
+            let old_normal = a.plane.normal;
+            if let Some((mut plane, _)) = a.moments.fit_plane() {
+                if plane.normal.dot(old_normal) < 0.0 {
+                    plane.normal = -plane.normal;
+                    plane.offset = -plane.offset;
+                }
+                a.plane = plane;
+                a.frame = a.frame.realigned(&plane);
             }
-            a.plane = plane;
-            a.frame = a.frame.realigned(&plane);
+            b.clone()
         }
-    }
-    let (fa, fb) = (a.frame, b.frame);
+        Kind::Layers => std::mem::replace(
+            a,
+            Primitive {
+                id: a.id,
+                ..b.clone()
+            },
+        ),
+    };
+    let (fa, fo) = (a.frame, other.frame);
     a.footprint
-        .merge_mapped(&b.footprint, |q| fa.to_local(fb.to_world(q)));
-    let extra: Vec<DVec2> = params.hull.carried_vertices(&fb, &b.outline, &fa);
+        .merge_mapped(&other.footprint, |q| fa.to_local(fo.to_world(q)));
+    let extra: Vec<DVec2> = params.hull.carried_vertices(&fo, &other.outline, &fa);
     a.reshape(params, &extra);
-    a.support += b.support;
-    a.born_scan = a.born_scan.min(b.born_scan);
-    a.last_scan = a.last_scan.max(b.last_scan);
+    a.support = support;
+    a.born_scan = born;
+    a.last_scan = last;
 }
 
 /// Merge until no pair of primitives, one of them in `changed` (ids), is
