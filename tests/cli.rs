@@ -60,7 +60,7 @@ fn polygon_count(json: &str) -> usize {
 #[test]
 fn help_on_every_command_succeeds_and_lists_its_options() {
     let top = run(&args(&["--help"])).unwrap();
-    for cmd in ["detect", "replay", "simulate", "eval"] {
+    for cmd in ["detect", "replay", "simulate", "eval", "ondata"] {
         assert!(top.contains(cmd), "{top}");
     }
     assert_eq!(run(&args(&["help"])).unwrap(), top);
@@ -100,7 +100,11 @@ fn help_on_every_command_succeeds_and_lists_its_options() {
     assert!(run(&args(&["replay", "--help"]))
         .unwrap()
         .contains("--report"));
-    for (cmd, opt) in [("simulate", "--scans"), ("eval", "GT_DIR")] {
+    for (cmd, opt) in [
+        ("simulate", "--scans"),
+        ("eval", "GT_DIR"),
+        ("ondata", "--radius"),
+    ] {
         let help = run(&args(&[cmd, "--help"])).unwrap();
         assert!(help.contains(opt), "{cmd}: {opt}\n{help}");
     }
@@ -247,4 +251,37 @@ fn poses_give_the_viewpoint_of_an_accumulated_cloud() {
         "0,0,0"
     ]))
     .is_err());
+}
+
+/// `ondata`: the polygons detected on a cloud lie on it; a polygon far from
+/// every point is named by its id with share 0; a bad radius is refused.
+#[test]
+fn ondata_measures_the_polygons_against_their_cloud() {
+    let dir = TempDir::new("ondata");
+    let cloud = write_cloud(&dir);
+    let pred = dir.0.join("pred.json");
+    let pred = pred.to_string_lossy().into_owned();
+    run(&args(&["detect", &cloud, "--out", &pred])).unwrap();
+    let out = run(&args(&["ondata", &pred, &cloud])).unwrap();
+    assert!(!out.contains('\n'), "one line: {out}");
+    let doc: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert!(doc["share"].as_f64().unwrap() >= 0.95, "{out}");
+    assert_eq!(doc["radius"].as_f64(), Some(0.2));
+    assert_eq!(doc["points"].as_u64(), Some(120 * 120 + 100 * 30));
+    assert!(doc["polygons"].as_array().unwrap().len() >= 2, "{out}");
+    // A 2 x 2 m square 50 m away from every point: share 0, under its id.
+    let off = dir.0.join("off.json");
+    std::fs::write(
+        &off,
+        r#"{"polygons":[{"id":7,"vertices":[[50,0,0],[52,0,0],[52,2,0],[50,2,0]]}]}"#,
+    )
+    .unwrap();
+    let off = off.to_string_lossy().into_owned();
+    let doc: serde_json::Value =
+        serde_json::from_str(&run(&args(&["ondata", &off, &cloud])).unwrap()).unwrap();
+    assert_eq!(doc["share"].as_f64(), Some(0.0));
+    assert_eq!(doc["polygons"][0]["id"].as_u64(), Some(7));
+    assert_eq!(doc["polygons"][0]["share"].as_f64(), Some(0.0));
+    let e = run(&args(&["ondata", &off, &cloud, "--radius=-1"])).unwrap_err();
+    assert!(e.to_string().contains("--radius"), "{e}");
 }

@@ -63,6 +63,18 @@
 //! `x, y, z` per vertex (12 bytes) plus the plane as four `f32` (16 bytes) per
 //! polygon — with the input points as `f32` `x, y, z` (12 bytes each).
 //!
+//! **On the data** ([`on_data`], no ground truth needed, so it applies to
+//! real scans) is the share of the predictions' area that has a point of the
+//! cloud within a radius (3D Euclidean distance, inclusive): an outline that
+//! stays on the data has every part of its area near some return; area far
+//! from every point is space the polygon claims but nothing was seen in.
+//! Each polygon is sampled at the centres of a square grid in its own frame
+//! (spacing [`ON_DATA_SPACING`], 0.05 m; coarsened to at most
+//! [`ON_DATA_MAX_SAMPLES`], 200 000, samples; refined for small polygons as
+//! above); its share is the fraction of its samples near a point (of its
+//! outline samples when it is too small for a grid sample). The total is
+//! area-weighted: `sum(area_i * share_i) / sum(area_i)`.
+//!
 //! The evaluation is deterministic (no hashing, no threads, `libm` for the
 //! transcendental functions) and does not panic: invalid inputs are errors.
 
@@ -71,6 +83,7 @@ mod coverage;
 mod duplicates;
 mod index;
 mod metrics;
+mod ondata;
 mod options;
 mod report;
 mod sampling;
@@ -81,6 +94,7 @@ pub use metrics::{
     Accuracy, Compactness, Completeness, Detection, DuplicatePair, Duplicates, Metrics,
     PredictionReport, SurfaceReport, BYTES_PER_INPUT_POINT, BYTES_PER_POLYGON, BYTES_PER_VERTEX,
 };
+pub use ondata::{OnData, PolygonOnData, ON_DATA_MAX_SAMPLES, ON_DATA_SPACING};
 pub use options::EvalOptions;
 
 use crate::error::{Error, Result};
@@ -104,6 +118,44 @@ pub struct GtSurface {
 /// truth), for checking a scenario after every scan.
 pub fn duplicates(pred: &[Polygon3], opts: &EvalOptions) -> Duplicates {
     duplicates::find(pred, opts)
+}
+
+/// Share of the area of `polygons` that has a point of `points` within
+/// `radius` metres (3D distance, inclusive), overall (area-weighted) and per
+/// polygon. See the [module docs](self) for the sampling.
+///
+/// Total, never panics: non-finite points are ignored; a polygon with a
+/// non-finite or non-orthonormal frame or a non-finite vertex counts with
+/// area 0 and share 0; a negative or NaN `radius` counts as 0 (a point must
+/// sit on a sample), an infinite one makes any point count. Without polygon
+/// area the share is 1 (no area lies off the data); with area but without
+/// points it is 0.
+///
+/// ```
+/// use glam::DVec3;
+/// use polyscene::geometry::Polygon3;
+/// // A 1 x 1 m square at z = 0 and points every 0.1 m over it, 0.1 m above.
+/// let square = Polygon3::from_world(&[
+///     DVec3::new(0.0, 0.0, 0.0),
+///     DVec3::new(1.0, 0.0, 0.0),
+///     DVec3::new(1.0, 1.0, 0.0),
+///     DVec3::new(0.0, 1.0, 0.0),
+/// ])
+/// .unwrap();
+/// let above = |z: f64| -> Vec<DVec3> {
+///     (0..100)
+///         .map(|k| DVec3::new(0.05 + 0.1 * (k % 10) as f64, 0.05 + 0.1 * (k / 10) as f64, z))
+///         .collect()
+/// };
+/// let on = polyscene::eval::on_data(&[square.clone()], &above(0.1), 0.2);
+/// assert_eq!(on.share, 1.0);
+/// assert_eq!(on.polygons[0].share, 1.0);
+/// // The same points 0.5 m above the plane: none is within 0.2 m.
+/// let off = polyscene::eval::on_data(&[square], &above(0.5), 0.2);
+/// assert_eq!(off.share, 0.0);
+/// ```
+pub fn on_data(polygons: &[Polygon3], points: &[DVec3], radius: f64) -> OnData {
+    ondata::measure(polygons, points, radius)
 }
 
 /// Evaluate predicted polygons `pred` against the ground truth `gt`, given

@@ -46,6 +46,9 @@ enum Cmd {
     Simulate(SimulateArgs),
     /// Score polygons against a simulated dataset's ground truth
     Eval(EvalArgs),
+    /// Share of the polygons' area with a point of the cloud within --radius
+    /// (no ground truth needed; one JSON line)
+    Ondata(OnDataArgs),
 }
 
 #[derive(Args)]
@@ -118,6 +121,24 @@ struct EvalArgs {
     /// A simulated dataset with ground_truth.json and .label files
     #[arg(value_name = "GT_DIR")]
     gt_dir: String,
+}
+
+#[derive(Args)]
+struct OnDataArgs {
+    /// Polygons to measure: a JSON document as `detect` and `replay` write
+    #[arg(value_name = "PRED.json")]
+    pred: String,
+    /// The cloud they were made from, in the same frame: little-endian f32
+    /// values, `--stride` of them per point
+    #[arg(value_name = "CLOUD.bin")]
+    cloud: String,
+    /// Values per point: 3 (x, y, z) or 4 (x, y, z, intensity)
+    #[arg(long, value_name = "3|4", default_value_t = 4)]
+    stride: usize,
+    /// Distance (m) from a polygon's sample to the nearest point that still
+    /// counts as on the data
+    #[arg(long, value_name = "M", default_value_t = 0.2)]
+    radius: f64,
 }
 
 /// `minArea` -> `min-area`.
@@ -206,6 +227,7 @@ pub fn run(argv: &[String]) -> Result<String> {
         }
         Cmd::Simulate(a) => simulate_cmd(a),
         Cmd::Eval(a) => eval_cmd(a),
+        Cmd::Ondata(a) => ondata_cmd(a),
     }
 }
 
@@ -399,27 +421,39 @@ struct PredDoc {
 
 #[derive(serde::Deserialize)]
 struct PredPolygon {
+    #[serde(default)]
+    id: Option<u32>,
     vertices: Vec<[f64; 3]>,
 }
 
-fn eval_cmd(args: EvalArgs) -> Result<String> {
-    let (pred_path, gt_dir) = (args.pred, args.gt_dir);
-    let text = std::fs::read_to_string(&pred_path)
+/// The polygons of a `detect`/`replay` document with their ids (the
+/// position in the file when a polygon has none); polygons without area
+/// (fewer than three vertices, collinear) are left out.
+fn read_pred(pred_path: &str) -> Result<Vec<(u32, crate::geometry::Polygon3)>> {
+    let text = std::fs::read_to_string(pred_path)
         .map_err(|e| Error::Io(format!("cannot read {pred_path}: {e}")))?;
     let doc: PredDoc = serde_json::from_str(&text)
         .map_err(|e| Error::Io(format!("{pred_path}: not a polygons document: {e}")))?;
-    let pred: Vec<crate::geometry::Polygon3> = doc
+    Ok(doc
         .polygons
         .iter()
-        .filter_map(|p| {
+        .enumerate()
+        .filter_map(|(i, p)| {
             let v: Vec<glam::DVec3> = p
                 .vertices
                 .iter()
                 .map(|&a| glam::DVec3::from_array(a))
                 .collect();
-            crate::geometry::Polygon3::from_world(&v)
+            let id = p.id.unwrap_or(i as u32);
+            crate::geometry::Polygon3::from_world(&v).map(|poly| (id, poly))
         })
-        .collect();
+        .collect())
+}
+
+fn eval_cmd(args: EvalArgs) -> Result<String> {
+    let (pred_path, gt_dir) = (args.pred, args.gt_dir);
+    let pred: Vec<crate::geometry::Polygon3> =
+        read_pred(&pred_path)?.into_iter().map(|p| p.1).collect();
     let data = crate::sim::read_dataset(Path::new(&gt_dir))?;
     let gt = data
         .ground_truth
@@ -457,4 +491,61 @@ fn eval_cmd(args: EvalArgs) -> Result<String> {
         &crate::eval::EvalOptions::default(),
     )?;
     Ok(metrics.to_string())
+}
+
+/// One polygon of the `ondata` output.
+#[derive(Serialize)]
+struct OnDataPolygonJson {
+    id: u32,
+    area: f64,
+    samples: usize,
+    share: f64,
+}
+
+/// The JSON line `ondata` prints.
+#[derive(Serialize)]
+#[serde(rename_all = "camelCase")]
+struct OnDataJson {
+    radius: f64,
+    points: usize,
+    area: f64,
+    near_area: f64,
+    share: f64,
+    /// In the order of the file.
+    polygons: Vec<OnDataPolygonJson>,
+}
+
+fn ondata_cmd(args: OnDataArgs) -> Result<String> {
+    if args.radius.is_nan() || args.radius < 0.0 {
+        return Err(Error::Invalid(format!(
+            "--radius {}: expected a distance of 0 m or more",
+            args.radius
+        )));
+    }
+    let pred = read_pred(&args.pred)?;
+    let values = crate::io::read_bin(Path::new(&args.cloud), args.stride)?;
+    let points: Vec<glam::DVec3> = values
+        .chunks_exact(args.stride)
+        .map(|p| glam::DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
+        .collect();
+    let polygons: Vec<crate::geometry::Polygon3> = pred.iter().map(|p| p.1.clone()).collect();
+    let r = crate::eval::on_data(&polygons, &points, args.radius);
+    let doc = OnDataJson {
+        radius: r.radius,
+        points: r.points,
+        area: r.area,
+        near_area: r.near_area,
+        share: r.share,
+        polygons: pred
+            .iter()
+            .zip(&r.polygons)
+            .map(|((id, _), p)| OnDataPolygonJson {
+                id: *id,
+                area: p.area,
+                samples: p.samples,
+                share: p.share,
+            })
+            .collect(),
+    };
+    write_or_return(&doc, None)
 }
