@@ -13,7 +13,10 @@ pub const MAX_COORDINATE: f64 = 1e9;
 fn check_range(points: impl Iterator<Item = DVec3>) -> Result<()> {
     for (i, p) in points.enumerate() {
         if p.abs().max_element() > MAX_COORDINATE {
-            return Err(Error::OutOfRange { point: i });
+            return Err(Error::OutOfRange {
+                point: i,
+                limit: MAX_COORDINATE,
+            });
         }
     }
     Ok(())
@@ -123,7 +126,10 @@ impl Cloud {
         for (i, p) in values.chunks_exact(stride).enumerate() {
             let w = pose.transform_point3(DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
             if w.abs().max_element() > MAX_COORDINATE {
-                return Err(Error::OutOfRange { point: i });
+                return Err(Error::OutOfRange {
+                    point: i,
+                    limit: MAX_COORDINATE,
+                });
             }
             points.push((w - origin).as_vec3());
         }

@@ -26,6 +26,8 @@ pub enum Error {
     OutOfRange {
         /// Index of the point.
         point: usize,
+        /// The limit (m).
+        limit: f64,
     },
     /// A pose that is not a rigid transform, or of the wrong size.
     BadPose(String),
@@ -58,11 +60,10 @@ impl fmt::Display for Error {
             Error::NonFinite { point } => {
                 write!(f, "point {point} has a NaN or infinite coordinate")
             }
-            Error::OutOfRange { point } => write!(
+            Error::OutOfRange { point, limit } => write!(
                 f,
-                "point {point} lies more than {:e} m from the world origin (after the \
-                 pose, for a scan); coordinates are metres",
-                crate::cloud::MAX_COORDINATE,
+                "point {point} lies more than {limit:e} m from the world origin (after the \
+                 pose, for a scan); coordinates are metres"
             ),
             Error::BadPose(why) => write!(f, "invalid pose: {why}"),
             Error::BadOption { key, reason } => write!(f, "option '{key}': {reason}"),
