@@ -42,24 +42,8 @@ pub struct MergeEvent {
 ///   tells planes apart, such as one surface seen again through a pose a
 ///   few centimetres off.
 pub fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
-    merge_kind(a, b, params).is_some()
-}
-
-/// How two mergeable primitives relate.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Kind {
-    /// Pieces of one surface that grew together: their statistics join.
-    Pieces,
-    /// One surface and a layer over it within the inlier distance, seen
-    /// through a pose error: the layer's footprint joins, its points stay
-    /// out of the survivor's plane.
-    Layers,
-}
-
-/// [`mergeable`], telling which way.
-pub(crate) fn merge_kind(a: &Primitive, b: &Primitive, params: &Params) -> Option<Kind> {
     if a.plane.angle_to(&b.plane) > params.merge_angle.to_radians() {
-        return None;
+        return false;
     }
     // The smaller one must lie on the larger one's plane: the RMS distance
     // of its outline vertices and centroid. A centroid test alone is
@@ -91,12 +75,12 @@ pub(crate) fn merge_kind(a: &Primitive, b: &Primitive, params: &Params) -> Optio
     let close = ms.sqrt() <= params.merge_distance || centroids;
     let layered = !close && ms.sqrt() <= params.other.distance;
     if !close && !layered {
-        return None;
+        return false;
     }
     let ((alo, ahi), (blo, bhi)) = (bounds(&av), bounds(&bv));
     let pad = DVec3::splat(params.merge_gap + params.merge_distance.max(params.other.distance));
     if (alo - pad).cmpgt(bhi).any() || (blo - pad).cmpgt(ahi).any() {
-        return None;
+        return false;
     }
     if layered {
         let inside = small_v
@@ -104,9 +88,9 @@ pub(crate) fn merge_kind(a: &Primitive, b: &Primitive, params: &Params) -> Optio
             .map(|&v| big.frame.to_local(v))
             .filter(|&q| contains(&big.outline, q) || distance(&big.outline, q) <= params.merge_gap)
             .count();
-        return (4 * inside >= 3 * small_v.len()).then_some(Kind::Layers);
+        return 4 * inside >= 3 * small_v.len();
     }
     // The outlines, both in a's frame: touching or overlapping?
     let b_in_a: Vec<DVec2> = bv.iter().map(|&v| a.frame.to_local(v)).collect();
-    rings_within(&a.outline, &b_in_a, params.merge_gap).then_some(Kind::Pieces)
+    rings_within(&a.outline, &b_in_a, params.merge_gap)
 }

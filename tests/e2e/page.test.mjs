@@ -237,13 +237,14 @@ test('corrupt and unsupported files give a clear message; the page keeps working
 });
 
 test('a KITTI sequence with poses.txt runs as a scenario in name order', { timeout: 60_000 }, async () => {
-  // Three scans (the same real scan, driven 1 m forward each time) named out of order.
+  // Three scans (the same real scan, driven 0.25 m forward each time, the
+  // spacing of a real sequence at 2.5 m/s) named out of order.
   const dir = path.join(scratch, 'seq');
   mkdirSync(dir);
   const scan = readFileSync(path.join(WWW, 'data/ouster_os1_64_legacy_f12073.bin'));
   const names = ['000002.bin', '000000.bin', '000001.bin'];
   for (const n of names) writeFileSync(path.join(dir, n), scan);
-  const pose = (x) => `1 0 0 ${x} 0 1 0 0 0 0 1 0`;
+  const pose = (i) => `1 0 0 ${0.25 * i} 0 1 0 0 0 0 1 0`;
   writeFileSync(path.join(dir, 'short_poses.txt'), `${pose(0)}\n${pose(1)}\n`);
   writeFileSync(path.join(dir, 'poses.txt'), `${pose(0)}\n${pose(1)}\n${pose(2)}\n`);
 
@@ -257,9 +258,9 @@ test('a KITTI sequence with poses.txt runs as a scenario in name order', { timeo
     { timeout: 45_000 },
   );
   assert.ok((await stat('stat-polygons')) > 3);
-  // Scans 2 and 3 repeat scan 1 one metre further along x: the ground and the
+  // Scans 2 and 3 repeat scan 1 0.25 m further along x: the ground and the
   // facades along x still fit, so expansion takes most of what detection
-  // explained in scan 1 (planes across x moved by 1-2 m and do not fit).
+  // explained in scan 1 (planes across x moved by 0.25-0.5 m do not fit).
   const reports = await page.evaluate(() => window.polyscene.app.reports);
   assert.deepEqual(reports.map((r) => r.scan), [0, 1, 2]);
   const first = reports[0].explainedByDetection;
