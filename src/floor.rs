@@ -92,31 +92,27 @@ impl FloorGrid {
     pub(crate) fn on_floor(&self, p: DVec3) -> bool {
         self.at(p.x, p.y).is_some_and(|f| p.z - f <= GROUND_RISE)
     }
+}
 
-    /// The lowest floor within `radius` (m) of `(x, y)`, horizontally.
-    pub(crate) fn lowest_near(&self, x: f64, y: f64, radius: f64) -> Option<f64> {
-        let r = (radius / CELL).ceil() as i64;
-        let (cx, cy) = key(x, y);
-        let mut lowest: Option<f64> = None;
-        for i in cx - r..=cx + r {
-            for j in cy - r..=cy + r {
-                if let Some(&f) = self.floor.get(&(i, j)) {
-                    lowest = Some(lowest.map_or(f, |l| l.min(f)));
-                }
-            }
+/// Could a sensor have stood at `p` (the points' coordinates): points
+/// within 10 m of it horizontally, and `p` between 0.3 m and 5 m above
+/// their floor (a LiDAR on a robot, a car's roof or a tripod)? A cloud in
+/// its sensor's own frame has its sensor at the origin; a world-frame map's
+/// origin is usually elsewhere, or on the ground. One pass over the points,
+/// without the floor grid.
+pub(crate) fn sensor_could_stand_at(pts: &[Vec3], p: DVec3) -> bool {
+    const RADIUS: f64 = 10.0;
+    let mut lowest = Lowest {
+        n: 0,
+        z: [f32::INFINITY; RANK + 1],
+    };
+    for q in pts {
+        let (dx, dy) = (q.x as f64 - p.x, q.y as f64 - p.y);
+        if dx * dx + dy * dy <= RADIUS * RADIUS && q.z.is_finite() {
+            lowest.push(q.z);
         }
-        lowest
     }
-
-    /// Could a sensor have stood at `p`: some floor within 10 m of it, and
-    /// `p` between 0.3 m and 5 m above the lowest of it (a LiDAR on a robot,
-    /// a car's roof or a tripod)? A cloud in its sensor's own frame has its
-    /// sensor at the origin; a world-frame map's origin is usually elsewhere,
-    /// or on the ground.
-    pub(crate) fn could_be_sensor(&self, p: DVec3) -> bool {
-        self.lowest_near(p.x, p.y, 10.0)
-            .is_some_and(|f| (0.3..=5.0).contains(&(p.z - f)))
-    }
+    lowest.n > 0 && (0.3..=5.0).contains(&(p.z - lowest.floor()))
 }
 
 /// How a plane is told to be ground (ground planes get their own inlier
@@ -236,10 +232,10 @@ mod tests {
 
     #[test]
     fn a_sensor_stands_above_the_floor_not_on_it() {
-        let g = FloorGrid::new(&scene());
-        assert!(g.could_be_sensor(DVec3::new(20.0, 20.0, 1.8)));
-        assert!(!g.could_be_sensor(DVec3::new(20.0, 20.0, 0.0)));
-        assert!(!g.could_be_sensor(DVec3::new(20.0, 20.0, 30.0)));
-        assert!(!g.could_be_sensor(DVec3::new(-500.0, 0.0, 1.8)));
+        let pts = scene();
+        assert!(sensor_could_stand_at(&pts, DVec3::new(20.0, 20.0, 1.8)));
+        assert!(!sensor_could_stand_at(&pts, DVec3::new(20.0, 20.0, 0.0)));
+        assert!(!sensor_could_stand_at(&pts, DVec3::new(20.0, 20.0, 30.0)));
+        assert!(!sensor_could_stand_at(&pts, DVec3::new(-500.0, 0.0, 1.8)));
     }
 }

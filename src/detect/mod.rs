@@ -17,7 +17,7 @@ pub use policy::{CascadePolicy, GroundBy};
 use crate::clock;
 use crate::cloud::Cloud;
 use crate::error::Result;
-use crate::floor::{FloorGrid, GroundRule};
+use crate::floor::{sensor_could_stand_at, FloorGrid, GroundRule};
 use crate::params::Params;
 use crate::primitive::Primitive;
 use crate::rng::Rng;
@@ -95,27 +95,16 @@ pub fn detect(cloud: &Cloud, params: &Params) -> Result<Detection> {
         let det = Detector::new(params, policy);
         return Ok(det.run(&cloud.points, cloud.origin, DVec3::from_array(v)));
     }
-    let floor = FloorGrid::new(&cloud.points);
-    let det = if floor.could_be_sensor(-cloud.origin) {
-        Detector::new(params, policy)
-    } else {
-        Detector::new(params, policy.without_viewpoint())
-    };
-    let viewpoint = if det.policy.ground == GroundBy::LocalFloor {
-        // Seen from nowhere: normals face a point high above the centre.
-        let n = cloud.points.len().max(1) as f64;
-        let mean = cloud.points.iter().map(|p| p.as_dvec3()).sum::<DVec3>() / n;
-        cloud.origin + mean + DVec3::new(0.0, 0.0, 1e4)
-    } else {
-        DVec3::ZERO
-    };
-    Ok(det.run_with_floor(
-        &cloud.points,
-        cloud.origin,
-        viewpoint,
-        Rng::new(params.seed),
-        Some(&floor),
-    ))
+    if sensor_could_stand_at(&cloud.points, -cloud.origin) {
+        let det = Detector::new(params, policy);
+        return Ok(det.run(&cloud.points, cloud.origin, DVec3::ZERO));
+    }
+    // Seen from nowhere: normals face a point high above the centre.
+    let n = cloud.points.len().max(1) as f64;
+    let mean = cloud.points.iter().map(|p| p.as_dvec3()).sum::<DVec3>() / n;
+    let viewpoint = cloud.origin + mean + DVec3::new(0.0, 0.0, 1e4);
+    let det = Detector::new(params, policy.without_viewpoint());
+    Ok(det.run(&cloud.points, cloud.origin, viewpoint))
 }
 
 /// The detection cascade: parameters (validated by the caller) and the
@@ -146,29 +135,12 @@ impl<'p> Detector<'p> {
         viewpoint: DVec3,
         rng: Rng,
     ) -> Detection {
-        self.run_with_floor(pts, origin, viewpoint, rng, None)
-    }
-
-    /// [`Detector::run_with_rng`] with the floor of `pts`, when the caller
-    /// has it (built here when the policy needs it and none is given).
-    fn run_with_floor(
-        &self,
-        pts: &[Vec3],
-        origin: DVec3,
-        viewpoint: DVec3,
-        rng: Rng,
-        floor: Option<&FloorGrid>,
-    ) -> Detection {
         let (p, policy) = (self.params, &self.policy);
         let t0 = clock::now_ms();
-        let own_floor;
-        let ground = match (policy.ground, floor) {
-            (GroundBy::Viewpoint, _) => GroundRule::BelowViewpoint,
-            (GroundBy::LocalFloor, Some(f)) => GroundRule::LocalFloor(f),
-            (GroundBy::LocalFloor, None) => {
-                own_floor = FloorGrid::new(pts);
-                GroundRule::LocalFloor(&own_floor)
-            }
+        let floor = (policy.ground == GroundBy::LocalFloor).then(|| FloorGrid::new(pts));
+        let ground = match &floor {
+            Some(f) => GroundRule::LocalFloor(f),
+            None => GroundRule::BelowViewpoint,
         };
         let local_viewpoint = viewpoint - origin;
         let mut pool = PlanePool::new(
