@@ -555,24 +555,8 @@ fn clouds_beyond_the_scoring_pool_keep_small_planes_and_stay_total() {
 /// rejected and the road was lost but for a 140 m^2 piece).
 #[test]
 fn simulated_street_scans_and_a_location_meet_quality_floors() {
-    use polyscene::eval::{evaluate, EvalOptions, GtSurface};
-    use polyscene::sim::{Drive, DriveOptions, Layout, SensorModel};
-    let drive = Drive::new(
-        Layout::Street,
-        1,
-        SensorModel::default(),
-        DriveOptions::default(),
-    )
-    .unwrap();
-    let gt: Vec<GtSurface> = drive
-        .scene()
-        .polygons
-        .iter()
-        .map(|g| GtSurface {
-            id: g.id,
-            polygon: g.polygon.clone(),
-        })
-        .collect();
+    use polyscene::eval::{evaluate, EvalOptions};
+    let (drive, gt) = street_truth();
     let opts = EvalOptions::default();
     let (mut recall, mut mean, mut completeness) = (0.0, 0.0, 0.0);
     let scans = [10, 30, 50, 70, 90];
@@ -1048,15 +1032,8 @@ fn the_ground_outline_follows_far_rings_as_far_as_they_cluster() {
 /// viewpoint 0.88.
 #[test]
 fn a_world_frame_location_without_a_viewpoint_keeps_its_ground() {
-    use polyscene::eval::{evaluate, EvalOptions, GtSurface};
-    use polyscene::sim::{Drive, DriveOptions, Layout, SensorModel};
-    let drive = Drive::new(
-        Layout::Street,
-        1,
-        SensorModel::default(),
-        DriveOptions::default(),
-    )
-    .unwrap();
+    use polyscene::eval::{evaluate, EvalOptions};
+    let (drive, gt) = street_truth();
     let loc = drive.location(20, 10).unwrap();
     let cloud = Cloud::from_world_f64(&loc.points).unwrap();
     let p = Params::gpp2();
@@ -1070,15 +1047,6 @@ fn a_world_frame_location_without_a_viewpoint_keeps_its_ground() {
         .map(|q| q.area)
         .sum();
     assert!(ground > 900.0, "ground {ground} m^2");
-    let gt: Vec<GtSurface> = drive
-        .scene()
-        .polygons
-        .iter()
-        .map(|g| GtSurface {
-            id: g.id,
-            polygon: g.polygon.clone(),
-        })
-        .collect();
     let polys: Vec<_> = det.primitives.iter().map(|q| q.polygon()).collect();
     let m = evaluate(
         &polys,
@@ -1096,4 +1064,26 @@ fn a_world_frame_location_without_a_viewpoint_keeps_its_ground() {
     );
     assert!(m.detection.precision > 0.93, "{}", m.detection.precision);
     assert_eq!(m.duplicates.count, 0);
+}
+
+/// The simulated street drive (seed 1) and its ground-truth surfaces.
+fn street_truth() -> (polyscene::sim::Drive, Vec<polyscene::eval::GtSurface>) {
+    use polyscene::sim::{Drive, DriveOptions, Layout, SensorModel};
+    let drive = Drive::new(
+        Layout::Street,
+        1,
+        SensorModel::default(),
+        DriveOptions::default(),
+    )
+    .unwrap();
+    let gt = drive
+        .scene()
+        .polygons
+        .iter()
+        .map(|g| polyscene::eval::GtSurface {
+            id: g.id,
+            polygon: g.polygon.clone(),
+        })
+        .collect();
+    (drive, gt)
 }
