@@ -22,8 +22,9 @@ fn check_range(points: impl Iterator<Item = DVec3>) -> Result<()> {
     Ok(())
 }
 
-/// Check that a flat buffer has a valid stride and finite x, y, z.
-pub fn check_finite(values: &[f32], stride: usize) -> Result<()> {
+/// Check that a flat buffer has a valid stride and finite x, y, z; returns
+/// the largest absolute coordinate.
+pub fn check_finite(values: &[f32], stride: usize) -> Result<f32> {
     if stride != 3 && stride != 4 {
         return Err(Error::BadStride(stride));
     }
@@ -33,12 +34,23 @@ pub fn check_finite(values: &[f32], stride: usize) -> Result<()> {
             stride,
         });
     }
+    largest_coordinate(values, stride)
+}
+
+/// The largest absolute coordinate of the points (checked as in
+/// [`check_finite`], whose checks the caller has made on stride and length).
+fn largest_coordinate(values: &[f32], stride: usize) -> Result<f32> {
+    let mut largest = 0.0f32;
     for (i, p) in values.chunks_exact(stride).enumerate() {
         if !(p[0].is_finite() && p[1].is_finite() && p[2].is_finite()) {
             return Err(Error::NonFinite { point: i });
         }
+        let m = p[0].abs().max(p[1].abs()).max(p[2].abs());
+        if m > largest {
+            largest = m;
+        }
     }
-    Ok(())
+    Ok(largest)
 }
 
 /// Check that `m` is a rigid transform: finite, orthonormal rotation with
@@ -94,9 +106,11 @@ impl Cloud {
 
     /// From a flat f32 buffer (stride 3 or 4), world frame.
     pub fn from_flat(values: &[f32], stride: usize) -> Result<Self> {
-        check_finite(values, stride)?;
+        let largest = check_finite(values, stride)?;
         let at = |p: &[f32]| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
-        check_range(values.chunks_exact(stride).map(at))?;
+        if largest as f64 > MAX_COORDINATE {
+            check_range(values.chunks_exact(stride).map(at))?;
+        }
         Ok(Self::around_box_centre(values.chunks_exact(stride).map(at)))
     }
 
@@ -114,18 +128,24 @@ impl Cloud {
     /// the origin is the sensor position rounded to whole metres, and each
     /// point is transformed in f64.
     pub fn from_sensor(values: &[f32], stride: usize, pose: &DMat4) -> Result<Self> {
-        check_finite(values, stride)?;
+        let largest = check_finite(values, stride)?;
         check_rigid(pose)?;
-        if pose.w_axis.truncate().abs().max_element() > MAX_COORDINATE {
+        let t = pose.w_axis.truncate();
+        if t.abs().max_element() > MAX_COORDINATE {
             return Err(Error::BadPose(format!(
                 "its translation lies more than {MAX_COORDINATE:e} m from the world origin"
             )));
         }
-        let origin = pose.w_axis.truncate().round();
+        // A rotation keeps lengths: the points stay within |t| + sqrt(3)
+        // times their largest coordinate, and only beyond that bound is
+        // each one checked.
+        let reach = t.abs().max_element() + 3f64.sqrt() * largest as f64;
+        let check = reach > MAX_COORDINATE;
+        let origin = t.round();
         let mut points = Vec::with_capacity(values.len() / stride);
         for (i, p) in values.chunks_exact(stride).enumerate() {
             let w = pose.transform_point3(DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
-            if w.abs().max_element() > MAX_COORDINATE {
+            if check && w.abs().max_element() > MAX_COORDINATE {
                 return Err(Error::OutOfRange {
                     point: i,
                     limit: MAX_COORDINATE,
