@@ -24,12 +24,7 @@ fn bench(c: &mut Criterion) {
     let scan_view = scan.pose.w_axis.truncate().to_array();
     let loc = drive.location(20, 10).unwrap();
     let loc_cloud = Cloud::from_world_f64(&loc.points).unwrap();
-    let mean = loc
-        .poses
-        .iter()
-        .map(|p| p.w_axis.truncate())
-        .sum::<glam::DVec3>()
-        / loc.poses.len() as f64;
+    let mean = loc.viewpoint();
 
     let mut g = c.benchmark_group("detect");
     g.sample_size(10);

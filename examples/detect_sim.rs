@@ -39,11 +39,6 @@ fn main() {
     time("scan ", &cloud, scan.pose.w_axis.truncate(), 7);
     let loc = drive.location(20, 10).unwrap();
     let cloud = Cloud::from_world_f64(&loc.points).unwrap();
-    let mean = loc
-        .poses
-        .iter()
-        .map(|p| p.w_axis.truncate())
-        .sum::<glam::DVec3>()
-        / loc.poses.len() as f64;
+    let mean = loc.viewpoint();
     time("location", &cloud, mean, 3);
 }

@@ -84,12 +84,7 @@ fn main() {
         let d = Drive::new(layout, 1, SensorModel::default(), DriveOptions::default()).unwrap();
         let loc = d.location(20, 10).unwrap();
         let cloud = Cloud::from_world_f64(&loc.points).unwrap();
-        let mean = loc
-            .poses
-            .iter()
-            .map(|p| p.w_axis.truncate())
-            .sum::<glam::DVec3>()
-            / loc.poses.len() as f64;
+        let mean = loc.viewpoint();
         for hull in [HullKind::Concave, HullKind::Convex] {
             let p = Params {
                 viewpoint: Some(mean.to_array()),

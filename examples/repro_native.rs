@@ -113,8 +113,7 @@ fn export(args: &[String]) -> Res<()> {
         let labels = out.join(format!("{name}.labels"));
         write_bin(&bin, &flat)?;
         write_labels(&labels, &loc.labels)?;
-        let mean =
-            loc.poses.iter().map(|p| p.w_axis.truncate()).sum::<DVec3>() / loc.poses.len() as f64;
+        let mean = loc.viewpoint();
         clouds.push(CloudInfo {
             name,
             kind: "sim".into(),

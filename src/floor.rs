@@ -126,6 +126,21 @@ pub(crate) enum GroundRule<'g> {
 }
 
 impl GroundRule<'_> {
+    /// Is `plane` ground: near-horizontal, and below the viewpoint by
+    /// `depth` or, with a floor, on it as `on_floor` judges?
+    fn is_ground(
+        &self,
+        plane: &Plane,
+        viewpoint: DVec3,
+        (min_cos, depth): (f64, f64),
+        on_floor: impl FnOnce(&FloorGrid) -> bool,
+    ) -> bool {
+        match self {
+            GroundRule::BelowViewpoint => plane.is_ground_below(viewpoint, min_cos, depth),
+            GroundRule::LocalFloor(grid) => plane.normal.z.abs() >= min_cos && on_floor(grid),
+        }
+    }
+
     /// Is `plane` ground, judged where it passes over `at` (a hypothesis,
     /// drawn near `at`)? `viewpoint` and `at` in the plane's coordinates,
     /// which are the floor's.
@@ -137,16 +152,11 @@ impl GroundRule<'_> {
         min_cos: f64,
         depth: f64,
     ) -> bool {
-        match self {
-            GroundRule::BelowViewpoint => plane.is_ground_below(viewpoint, min_cos, depth),
-            GroundRule::LocalFloor(grid) => {
-                plane.normal.z.abs() >= min_cos && {
-                    let n = plane.normal;
-                    let z = -(n.x * at.x + n.y * at.y + plane.offset) / n.z;
-                    grid.on_floor(DVec3::new(at.x, at.y, z))
-                }
-            }
-        }
+        self.is_ground(plane, viewpoint, (min_cos, depth), |grid| {
+            let n = plane.normal;
+            let z = -(n.x * at.x + n.y * at.y + plane.offset) / n.z;
+            grid.on_floor(DVec3::new(at.x, at.y, z))
+        })
     }
 
     /// Is `plane` (world coordinates) ground, judged on its support `pts`
@@ -159,13 +169,9 @@ impl GroundRule<'_> {
         min_cos: f64,
         depth: f64,
     ) -> bool {
-        match self {
-            GroundRule::BelowViewpoint => plane.is_ground_below(viewpoint, min_cos, depth),
-            GroundRule::LocalFloor(grid) => {
-                plane.normal.z.abs() >= min_cos
-                    && 2 * pts.iter().filter(|p| grid.on_floor(p.as_dvec3())).count() >= pts.len()
-            }
-        }
+        self.is_ground(plane, viewpoint, (min_cos, depth), |grid| {
+            2 * pts.iter().filter(|p| grid.on_floor(p.as_dvec3())).count() >= pts.len()
+        })
     }
 }
 

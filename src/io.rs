@@ -4,7 +4,7 @@
 //! three rows of a 4x4 world-from-sensor transform).
 
 use crate::error::{Error, Result};
-use glam::{DMat4, DVec4};
+use glam::{DMat4, DVec3, DVec4};
 use std::path::Path;
 
 /// Decode little-endian f32s; `stride` numbers per point. Errors on a length
@@ -70,6 +70,16 @@ pub fn write_labels(path: &Path, labels: &[u32]) -> Result<()> {
     }
     std::fs::write(path, bytes)
         .map_err(|e| Error::Io(format!("cannot write {}: {e}", path.display())))
+}
+
+/// The mean position of `poses` (world-from-sensor): the viewpoint of a
+/// cloud accumulated from them. `None` for no poses.
+pub fn mean_position(poses: &[DMat4]) -> Option<DVec3> {
+    if poses.is_empty() {
+        return None;
+    }
+    let sum: DVec3 = poses.iter().map(|m| m.w_axis.truncate()).sum();
+    Some(sum / poses.len() as f64)
 }
 
 /// Parse KITTI odometry poses: one pose per non-empty line, 12 numbers, the

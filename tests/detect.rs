@@ -594,7 +594,7 @@ fn simulated_street_scans_and_a_location_meet_quality_floors() {
 
     let loc = drive.location(0, 10).unwrap();
     let cloud = Cloud::from_world_f64(&loc.points).unwrap();
-    let centre = loc.poses.iter().map(|m| m.w_axis.truncate()).sum::<DVec3>() / 10.0;
+    let centre = loc.viewpoint();
     let p = Params {
         viewpoint: Some(centre.to_array()),
         ..Params::gpp2()
@@ -655,7 +655,7 @@ fn a_location_s_support_lies_within_the_outline_resolution() {
     )
     .unwrap();
     let loc = drive.location(80, 10).unwrap();
-    let centre = loc.poses.iter().map(|m| m.w_axis.truncate()).sum::<DVec3>() / 10.0;
+    let centre = loc.viewpoint();
     let det = detect_checked(&loc.points, centre.to_array());
     let road = &det.primitives[0];
     assert!(road.ground && road.area > 500.0, "{}", road.area);

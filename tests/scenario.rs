@@ -152,11 +152,7 @@ fn drive_through(layout: Layout) {
         &opts,
     )
     .unwrap();
-    let mean_pose = d.poses()[..SCANS]
-        .iter()
-        .map(|p| p.w_axis.truncate())
-        .sum::<DVec3>()
-        / SCANS as f64;
+    let mean_pose = polyscene::io::mean_position(&d.poses()[..SCANS]).unwrap();
     let cloud = common::cloud(&pts);
     // One-shot baselines on the accumulated cloud. The paper's Algorithm 1
     // (the largest cluster of each round's plane, nothing merged), as it

@@ -85,6 +85,14 @@ pub struct Location {
     pub poses: Vec<DMat4>,
 }
 
+impl Location {
+    /// The mean position of the scans' poses: the viewpoint to detect the
+    /// location from.
+    pub fn viewpoint(&self) -> DVec3 {
+        crate::io::mean_position(&self.poses).unwrap_or(DVec3::ZERO)
+    }
+}
+
 /// A simulated drive: a scene, a sensor and a trajectory at about 10 m/s,
 /// with scan `k` generated on demand (independently of other scans: its
 /// noise comes from `Rng::derive(seed, k)`).

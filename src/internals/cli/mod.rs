@@ -361,11 +361,9 @@ fn detect_cmd(args: DetectArgs, mut params: Params) -> Result<String> {
             Error::BadPose(m) => Error::BadPose(format!("{path}: {m}")),
             other => other,
         })?;
-        if poses.is_empty() {
-            return Err(Error::BadPose(format!("{path}: no poses")));
-        }
-        let sum: glam::DVec3 = poses.iter().map(|m| m.w_axis.truncate()).sum();
-        params.viewpoint = Some((sum / poses.len() as f64).to_array());
+        let mean = crate::io::mean_position(&poses)
+            .ok_or_else(|| Error::BadPose(format!("{path}: no poses")))?;
+        params.viewpoint = Some(mean.to_array());
     }
     let values = crate::io::read_bin(Path::new(&args.cloud), args.stride)?;
     let cloud = Cloud::from_flat(&values, args.stride)?;
