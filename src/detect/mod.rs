@@ -64,7 +64,7 @@ pub struct Detection {
 /// Detect planar polygons in a world-frame cloud seen from
 /// `params.viewpoint` (the sensor position), if given. Without one, the
 /// origin is taken for the sensor when one could have stood there (0.3 m
-/// to 5 m above the cloud's floor within 10 m: a scan in its own frame);
+/// to 5 m above the lowest points within 10 m: a scan in its own frame);
 /// otherwise (a map, a tile, scans accumulated from many poses) the cloud
 /// is seen from nowhere: the rules that need a viewpoint are off
 /// ([`CascadePolicy::without_viewpoint`]) and ground is decided from the

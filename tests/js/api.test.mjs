@@ -198,7 +198,7 @@ test("the .d.ts documents every option, with the preset's default", () => {
       }
     }
   }
-  assert.deepEqual(problems, [], "doc comments of Params in src/params.rs");
+  assert.deepEqual(problems, [], "option docs in src/params/table.rs");
 });
 
 test("the README's options table is current (node scripts/gen-js-docs.mjs)", () => {
