@@ -8,7 +8,7 @@ PORT ?= 8080
 help:
 	@echo "make demo   - set up, build and serve the page on http://127.0.0.1:$(PORT) (PORT=NNNN to change)"
 	@echo "make test   - set up and run every test (Rust, wasm, Node, browser)"
-	@echo "make build  - build the JS package: pkg/web, pkg/node, pkg/bundler"
+	@echo "make build  - build the JS package: pkg/web, pkg/node, and the npm tarball pkg/polyscene-*.tgz"
 	@echo "make bench  - native criterion benchmarks and the wasm benchmark (prints tables)"
 	@echo "make repro  - reproduce the paper's evaluation into REPRODUCTION.md"
 
@@ -17,7 +17,7 @@ setup:
 
 build:
 	scripts/setup.sh rust npm
-	scripts/build-wasm.sh
+	scripts/pack.sh
 
 demo:
 	scripts/setup.sh rust npm

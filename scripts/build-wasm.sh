@@ -3,7 +3,9 @@
 # binaryen from www/node_modules/.bin; Debian's is too old):
 #   pkg/web      ES module for browsers and module workers (init() first)
 #   pkg/node     CommonJS for Node (require("./pkg/node"))
-#   pkg/bundler  ES module for bundlers (webpack, vite, esbuild)
+# (wasm-pack's bundler target is not built: its `import * from "x.wasm"` needs
+# a wasm plugin in Vite and fails in esbuild; bundlers take pkg/web, whose
+# `new URL("polyscene_bg.wasm", import.meta.url)` Vite and webpack follow),
 # then copy pkg/web to www/pkg for the page, and print and record the
 # gzipped size of the wasm in pkg/wasm-size.txt.
 # Quick when nothing changed: the inputs' hash is kept in pkg/.inputs.sha256
@@ -32,8 +34,9 @@ inputs_hash() {
     xargs -0 sha256sum | sha256sum | cut -d' ' -f1
 }
 
-targets=(web nodejs bundler)
-dirs=(pkg/web pkg/node pkg/bundler)
+targets=(web nodejs)
+dirs=(pkg/web pkg/node)
+rm -rf pkg/bundler # from builds before it was dropped
 hash=$(inputs_hash)
 fresh=1
 for d in "${dirs[@]}" www/pkg; do
@@ -68,3 +71,4 @@ if [ "$gz" -gt 250000 ]; then
   echo "build-wasm: warning: the gzipped wasm is above the 250 kB (250,000 bytes) budget" >&2
 fi
 echo "$hash" >pkg/.inputs.sha256
+echo "build-wasm: the npm package: scripts/pack.sh (pkg/npm, pkg/polyscene-*.tgz)"

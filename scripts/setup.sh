@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Install what the build and the tests need, only when missing:
 #   rust    - the wasm32 target, wasm-bindgen-cli (same version as Cargo.lock), wasm-pack
-#   npm     - www/node_modules (three, lil-gui, playwright-core, binaryen for wasm-opt)
+#   npm     - www/node_modules (three, lil-gui, playwright-core, binaryen for wasm-opt);
+#             tests/package/tools/node_modules (vite, esbuild, typescript: the
+#             package test builds a scratch project with them)
 #   browser - Debian's chromium for the end-to-end test
 #   all     - everything
 # Nothing is downloaded from outside the package registries.
@@ -36,6 +38,11 @@ if has npm; then
   if [ ! -f www/node_modules/.package-lock.json ] || [ www/package-lock.json -nt www/node_modules/.package-lock.json ]; then
     echo "setup: installing npm packages in www/"
     (cd www && npm ci --no-audit --no-fund --loglevel=error)
+  fi
+  tools=tests/package/tools
+  if [ ! -f $tools/node_modules/.package-lock.json ] || [ $tools/package-lock.json -nt $tools/node_modules/.package-lock.json ]; then
+    echo "setup: installing vite, esbuild and typescript in $tools/"
+    (cd $tools && npm ci --no-audit --no-fund --loglevel=error)
   fi
 fi
 

@@ -124,7 +124,7 @@ const TS_PIPELINE_OPTIONS: &'static str =
 #[wasm_bindgen(unchecked_return_type = "Polygon[]")]
 pub fn detect(
     #[wasm_bindgen(unchecked_param_type = "Float32Array")] points: JsValue,
-    #[wasm_bindgen(unchecked_param_type = "DetectOptions")] options: Option<JsValue>,
+    #[wasm_bindgen(unchecked_optional_param_type = "DetectOptions")] options: Option<JsValue>,
 ) -> WasmResult<Array> {
     let options = DetectOptions::from_js(&options.unwrap_or(JsValue::UNDEFINED))?;
     let values = points_of(&points)?;
@@ -138,7 +138,7 @@ pub fn detect(
 /// populate a GUI.
 #[wasm_bindgen(js_name = defaultOptions, unchecked_return_type = "Required<Omit<PipelineOptions, \"preset\">>")]
 pub fn default_options(
-    #[wasm_bindgen(unchecked_param_type = "Preset | undefined")] preset: Option<String>,
+    #[wasm_bindgen(unchecked_optional_param_type = "Preset")] preset: Option<String>,
 ) -> WasmResult<JsValue> {
     let params = Params::preset(preset.as_deref().unwrap_or("gpp2"))?;
     to_js(&params)

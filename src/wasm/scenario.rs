@@ -43,7 +43,7 @@ impl JsScenario {
     /// Throws on an unknown key or a bad value, naming the key.
     #[wasm_bindgen(constructor)]
     pub fn new(
-        #[wasm_bindgen(unchecked_param_type = "ScenarioOptions")] options: Option<JsValue>,
+        #[wasm_bindgen(unchecked_optional_param_type = "ScenarioOptions")] options: Option<JsValue>,
     ) -> WasmResult<JsScenario> {
         let options = ScenarioOptions::from_js(&options.unwrap_or(JsValue::UNDEFINED))?;
         let inner = Scenario::new(options.params)?;
@@ -65,7 +65,7 @@ impl JsScenario {
     pub fn add_scan(
         &mut self,
         #[wasm_bindgen(unchecked_param_type = "Float32Array")] points: JsValue,
-        #[wasm_bindgen(unchecked_param_type = "ScanOptions")] options: Option<JsValue>,
+        #[wasm_bindgen(unchecked_optional_param_type = "ScanOptions")] options: Option<JsValue>,
     ) -> WasmResult<JsValue> {
         let scenario = self.get_mut()?;
         let options = ScanOptions::from_js(&options.unwrap_or(JsValue::UNDEFINED))?;

@@ -61,7 +61,7 @@ impl JsSimulation {
 /// or a bad value, naming the key.
 #[wasm_bindgen]
 pub fn simulate(
-    #[wasm_bindgen(unchecked_param_type = "SimulateOptions")] options: Option<JsValue>,
+    #[wasm_bindgen(unchecked_optional_param_type = "SimulateOptions")] options: Option<JsValue>,
 ) -> WasmResult<JsSimulation> {
     let options = SimulateOptions::from_js(&options.unwrap_or(JsValue::UNDEFINED))?;
     let drive = Drive::new(

@@ -1,42 +1,76 @@
 // Main-thread side of the polyscene worker (src/worker.js): start it, send
 // it commands, get its messages as DOM events. A page that embeds polyscene
 // (a web map, a dashboard) needs only this class and, for display, SceneView.
+// The npm package ships it as `polyscene/worker`.
 //
 //   const client = new PolysceneClient();
 //   client.addEventListener('scan', (e) => view.showScan(e.detail));
 //   client.configure({ preset: 'gpp2' }, { kind: 'sim', layout: 'street', seed: 1 }, { play: true });
+//   const polygons = await client.detect(cloud, { stride: 3 }, { signal });
 //
+// Anything may be called at once: the worker keeps every message until its
+// wasm is loaded (`client.ready` resolves then, with the option defaults).
 // Events (detail = the worker's message, see the PROTOCOL in worker.js):
-// 'ready', 'reset', 'scan', 'state', 'error'. Messages of an earlier run (sent
-// before the last configure) are dropped here, so listeners never see a scan
-// of a run that was replaced. Each 'scan' is acknowledged after the
-// listeners ran, which is the worker's back-pressure.
+// 'ready', 'reset', 'scan', 'state', 'error', 'progress'. Messages of an
+// earlier run (sent before the last configure) are dropped here, so
+// listeners never see a scan of a run that was replaced. Each 'scan' is
+// acknowledged after the listeners ran, which is the worker's back-pressure.
 
 export class PolysceneClient extends EventTarget {
-  constructor({ workerUrl = new URL('./worker.js', import.meta.url) } = {}) {
+  /**
+   * `workerUrl`: where the worker module is (default: worker.js next to this
+   * file; a bundler that follows `new Worker(new URL(...))`, such as Vite or
+   * webpack, bundles it). With esbuild, bundle worker.js as an entry point of
+   * its own and give its URL here.
+   */
+  constructor({ workerUrl } = {}) {
     super();
     this.workerUrl = workerUrl;
     this.run = 0;
     this.lastConfigure = null;
-    this.requests = new Map();
+    this.requests = new Map(); // snapshot requests: id -> resolve
+    this.calls = new Map(); // detect requests: id -> { message, resolve, reject, onProgress, signal, onAbort }
     this.nextRequest = 1;
     this.restarts = 0;
     this.#start();
   }
 
   #start() {
-    this.worker = new Worker(this.workerUrl, { type: 'module', name: 'polyscene' });
+    // The literal `new Worker(new URL('./worker.js', import.meta.url), ...)`
+    // is what bundlers recognise and bundle.
+    this.worker = this.workerUrl
+      ? new Worker(this.workerUrl, { type: 'module', name: 'polyscene' })
+      : new Worker(new URL('./worker.js', import.meta.url), { type: 'module', name: 'polyscene' });
     this.worker.onmessage = (ev) => this.#onMessage(ev.data);
     this.worker.onerror = (ev) => {
       ev.preventDefault?.();
-      this.#emit('error', { run: this.run, fatal: true, message: `worker failed: ${ev.message || 'could not start (is www/pkg built?)'}` });
+      const message = `worker failed: ${ev.message || 'could not start (is www/pkg built?)'}`;
+      this.#emit('error', { run: this.run, fatal: true, message });
+      this.#readyReject(new Error(message));
       this.#restart();
     };
+    /** Resolves with the worker's 'ready' message ({ defaults }) once its wasm is loaded. */
+    this.ready = new Promise((resolve, reject) => {
+      this.#readyResolve = resolve;
+      this.#readyReject = reject;
+    });
+    this.ready.catch(() => {}); // also reported as an 'error' event
+    // Calls that were waiting in the worker that was replaced.
+    for (const call of this.calls.values()) this.#post(call.message);
   }
 
-  #restart() {
-    if (this.restarts >= 3) return; // give up: keep showing the error
-    this.restarts++;
+  #readyResolve = () => {};
+  #readyReject = () => {};
+
+  #restart({ crash = true } = {}) {
+    if (crash) {
+      if (this.restarts >= 3) {
+        // Give up: keep showing the error.
+        for (const [id, call] of this.calls) this.#settle(id, call, new Error('the polyscene worker failed 3 times'));
+        return;
+      }
+      this.restarts++;
+    }
     this.worker.terminate();
     this.#start();
     if (this.lastConfigure) this.#post({ ...this.lastConfigure, run: ++this.run, play: false });
@@ -47,6 +81,19 @@ export class PolysceneClient extends EventTarget {
   }
 
   #onMessage(m) {
+    if (m.type === 'ready') this.#readyResolve(m);
+    if (m.type === 'progress' || m.type === 'result') {
+      const call = this.calls.get(m.request);
+      if (!call) return; // aborted
+      if (m.type === 'progress') {
+        call.onProgress?.(m);
+        this.#emit('progress', m);
+      } else {
+        this.#settle(m.request, call, m.error === undefined ? null : new Error(m.error), m.polygons);
+      }
+      return;
+    }
+    if (m.type === 'error' && m.fatal && m.run === 0) this.#readyReject(new Error(m.message));
     if (m.type === 'snapshot') {
       const r = this.requests.get(m.request);
       this.requests.delete(m.request);
@@ -116,7 +163,43 @@ export class PolysceneClient extends EventTarget {
     });
   }
 
+  /**
+   * One-shot `detect(points, options)` in the worker: a promise of the
+   * polygons. `points` is copied (structured clone), so it stays usable here
+   * and the call can be sent again if the worker is replaced. `onProgress`
+   * gets `{ stage: 'started', points }` when the worker begins it (also a
+   * 'progress' event). `signal` (an AbortSignal) rejects the promise with
+   * `signal.reason` at once; a call the worker had already been sent is
+   * stopped by replacing the worker (a fresh wasm instance, a few tens of
+   * ms): a run in progress then restarts paused from its first scan, with a
+   * 'reset' event, and other calls are sent again.
+   */
+  detect(points, options, { signal, onProgress } = {}) {
+    if (signal?.aborted) return Promise.reject(signal.reason);
+    const request = this.nextRequest++;
+    return new Promise((resolve, reject) => {
+      const call = { message: { type: 'detect', request, points, options }, resolve, reject, onProgress, signal };
+      if (signal) {
+        call.onAbort = () => {
+          this.#settle(request, call, signal.reason);
+          this.#restart({ crash: false });
+        };
+        signal.addEventListener('abort', call.onAbort, { once: true });
+      }
+      this.calls.set(request, call);
+      this.#post(call.message);
+    });
+  }
+
+  #settle(request, call, error, value) {
+    this.calls.delete(request);
+    call.signal?.removeEventListener('abort', call.onAbort);
+    if (error) call.reject(error);
+    else call.resolve(value);
+  }
+
   terminate() {
     this.worker.terminate();
+    for (const [id, call] of this.calls) this.#settle(id, call, new Error('the polyscene worker was terminated'));
   }
 }

@@ -19,6 +19,9 @@
 //   { type: 'speed', scansPerSecond }      0 = as fast as the library goes
 //   { type: 'ack', run }                   the page consumed one 'scan' message
 //   { type: 'snapshot', request }          ask for scenario.toJSON()
+//   { type: 'detect', request, points, options }
+//        One-shot detect(points, options) on a world-frame cloud, apart from
+//        the run (the run's scenario is untouched).
 // worker -> page
 //   { type: 'ready', defaults }            wasm loaded; defaults: every option of
 //                                          each preset ({ gpp1, gpp2 }), for a GUI
@@ -32,13 +35,23 @@
 //        are transferred too).
 //   { type: 'state', run, playing, done }
 //   { type: 'snapshot', request, json }     json: scenario.toJSONString() (exact)
+//   { type: 'progress', request, stage: 'started', points }
+//        the worker began a request (messages wait in order until the wasm is
+//        loaded, then each runs to its end)
+//   { type: 'result', request, polygons?, error?, ms }
+//        the request's answer: polygons (vertices transferred), or an error
+//        message
 //   { type: 'error', run, message, fatal }  fatal: the module is unusable,
 //                                            start a new worker
+//
+// Handshake: onmessage is set while the module first runs, before any await,
+// so nothing posted before the wasm is loaded is lost: every message waits
+// for 'ready' (or the fatal 'error') and then runs in the order it was sent.
 //
 // Back-pressure: at most MAX_IN_FLIGHT scans are posted and not yet acked, so
 // a slow page (software WebGL) never gets a growing queue of scans.
 
-import init, { Scenario, simulate, defaultOptions } from '../pkg/polyscene.js';
+import init, { Scenario, detect, simulate, defaultOptions } from '../pkg/polyscene.js';
 
 const MAX_IN_FLIGHT = 2;
 const IDENTITY = new Float64Array([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]);
@@ -221,9 +234,33 @@ function tick() {
   if (st.playing) schedule(Math.max(0, st.interval - (performance.now() - t0)));
 }
 
+/** A one-shot detection for a 'detect' request: always answers with a 'result'. */
+function runDetect({ request, points, options }) {
+  const t0 = performance.now();
+  postMessage({ type: 'progress', request, stage: 'started', points: points?.length ?? 0 });
+  let polygons;
+  try {
+    polygons = detect(points, options);
+  } catch (e) {
+    if (isTrap(e)) st.fatal = true;
+    postMessage({ type: 'result', request, error: `detect: ${msg(e)}`, ms: performance.now() - t0 });
+    return;
+  }
+  const transfer = [];
+  for (const p of polygons) {
+    p.vertices = owned(p.vertices);
+    transfer.push(p.vertices.buffer);
+  }
+  postMessage({ type: 'result', request, polygons, ms: performance.now() - t0 }, transfer);
+}
+
 onmessage = async (ev) => {
   await ready;
   const m = ev.data;
+  if (st.fatal && m.type === 'detect') {
+    postMessage({ type: 'result', request: m.request, error: 'the polyscene module stopped working; restarting it' });
+    return;
+  }
   if (st.fatal && m.type !== 'snapshot') {
     postMessage({ type: 'error', run: m.run ?? st.run, fatal: true, message: 'the polyscene module stopped working; restarting it' });
     return;
@@ -269,6 +306,9 @@ onmessage = async (ev) => {
         break;
       case 'snapshot':
         postMessage({ type: 'snapshot', request: m.request, json: st.scenario ? st.scenario.toJSONString() : null });
+        break;
+      case 'detect':
+        runDetect(m);
         break;
       default:
         throw new Error(`unknown message type '${m.type}'`);
