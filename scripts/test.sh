@@ -22,3 +22,5 @@ step "JS package: wasm-pack test --node and node --test against pkg/node"
 scripts/test-js.sh
 step "browser end-to-end test of the page"
 scripts/test-e2e.sh
+step "the npm package: installed from its tarball, in Node, tsc, Vite and esbuild (Chromium)"
+scripts/test-package.sh
