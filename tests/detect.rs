@@ -465,6 +465,66 @@ fn same_input_and_seed_same_output() {
 }
 
 #[test]
+fn progress_is_reported_after_each_round_and_can_stop_the_detection() {
+    use polyscene::detect::{detect_with_progress, Progress};
+    use std::ops::ControlFlow;
+    let mut rng = Rng::new(8);
+    let pts = box_room(&mut rng);
+    let c = cloud(&pts);
+    let p = Params::gpp2();
+    let plain = detect(&c, &p).unwrap();
+    let mut seen: Vec<Progress> = Vec::new();
+    let reported = detect_with_progress(&c, &p, &mut |at| {
+        seen.push(*at);
+        ControlFlow::Continue(())
+    })
+    .unwrap()
+    .expect("not stopped");
+    // Watching changes nothing.
+    assert_eq!(reported.primitives, plain.primitives);
+    assert_eq!(reported.labels, plain.labels);
+    assert_eq!(seen.len(), plain.steps.len(), "one report per round");
+    for (k, at) in seen.iter().enumerate() {
+        assert_eq!(at.round, k + 1);
+        assert_eq!(at.points, pts.len());
+        assert!(at.points_left <= pts.len());
+        if k > 0 {
+            assert!(
+                at.points_left <= seen[k - 1].points_left,
+                "points left only fall"
+            );
+            assert!(at.primitives >= seen[k - 1].primitives);
+        }
+    }
+    assert!(seen.last().unwrap().primitives >= plain.primitives.len());
+    // Stopped after the second round: no result, and no third report.
+    let mut calls = 0;
+    let stopped = detect_with_progress(&c, &p, &mut |at| {
+        calls += 1;
+        if at.round == 2 {
+            ControlFlow::Break(())
+        } else {
+            ControlFlow::Continue(())
+        }
+    })
+    .unwrap();
+    assert!(stopped.is_none());
+    assert_eq!(calls, 2);
+    // Bad options are errors before any round.
+    let bad = Params {
+        min_area: -1.0,
+        ..Params::gpp2()
+    };
+    let mut called = false;
+    assert!(detect_with_progress(&c, &bad, &mut |_| {
+        called = true;
+        ControlFlow::Continue(())
+    })
+    .is_err());
+    assert!(!called);
+}
+
+#[test]
 fn far_from_the_origin_gives_the_same_polygons_translated() {
     let mut rng = Rng::new(9);
     let pts = box_room(&mut rng);

@@ -55,12 +55,17 @@ export interface ErrorMessage {
   fatal: boolean;
 }
 
-/** The worker began a `detect` call. */
+/** The worker began a `detect` call ('started'), or finished a round of its cascade ('round': the first, then at most one per 50 ms). */
 export interface ProgressMessage {
   type: "progress";
   request: number;
-  stage: "started";
+  stage: "started" | "round";
+  /** Points of the cloud. */
   points: number;
+  /** 'round' only: rounds done, points not yet explained or discarded (falls towards 0), polygons so far. */
+  round?: number;
+  pointsLeft?: number;
+  polygons?: number;
 }
 
 export interface PolysceneClientEventMap {

@@ -24,6 +24,7 @@ use crate::rng::Rng;
 use glam::{DVec3, Vec3};
 use ransac::PlanePool;
 use serde::Serialize;
+use std::ops::ControlFlow;
 
 /// One round of the cascade (for the paper's Fig. 9 analysis).
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
@@ -89,22 +90,54 @@ pub struct Detection {
 /// assert!((found.primitives[0].area - 99.0).abs() < 3.0);
 /// ```
 pub fn detect(cloud: &Cloud, params: &Params) -> Result<Detection> {
+    let (det, viewpoint) = one_shot_detector(cloud, params)?;
+    Ok(det.run(&cloud.points, cloud.origin, viewpoint))
+}
+
+/// [`detect`] that calls `progress` after each round of the cascade (the
+/// rounds' count is not known in advance: `points_left` falls towards 0);
+/// [`ControlFlow::Break`] stops it there and gives `Ok(None)`. The result of
+/// a detection that runs to its end is the same as [`detect`]'s.
+pub fn detect_with_progress(
+    cloud: &Cloud,
+    params: &Params,
+    progress: &mut dyn FnMut(&Progress) -> ControlFlow<()>,
+) -> Result<Option<Detection>> {
+    let (det, viewpoint) = one_shot_detector(cloud, params)?;
+    let rng = Rng::new(params.seed);
+    let (found, stopped) = det.run_inner(&cloud.points, cloud.origin, viewpoint, rng, progress);
+    Ok((!stopped).then_some(found))
+}
+
+/// The detector and the viewpoint of a one-shot detection (see [`detect`]).
+fn one_shot_detector<'p>(cloud: &Cloud, params: &'p Params) -> Result<(Detector<'p>, DVec3)> {
     params.validate()?;
     let policy = CascadePolicy::one_shot();
     if let Some(v) = params.viewpoint {
-        let det = Detector::new(params, policy);
-        return Ok(det.run(&cloud.points, cloud.origin, DVec3::from_array(v)));
+        return Ok((Detector::new(params, policy), DVec3::from_array(v)));
     }
     if sensor_could_stand_at(&cloud.points, -cloud.origin) {
-        let det = Detector::new(params, policy);
-        return Ok(det.run(&cloud.points, cloud.origin, DVec3::ZERO));
+        return Ok((Detector::new(params, policy), DVec3::ZERO));
     }
     // Seen from nowhere: normals face a point high above the centre.
     let n = cloud.points.len().max(1) as f64;
     let mean = cloud.points.iter().map(|p| p.as_dvec3()).sum::<DVec3>() / n;
     let viewpoint = cloud.origin + mean + DVec3::new(0.0, 0.0, 1e4);
-    let det = Detector::new(params, policy.without_viewpoint());
-    Ok(det.run(&cloud.points, cloud.origin, viewpoint))
+    Ok((Detector::new(params, policy.without_viewpoint()), viewpoint))
+}
+
+/// Where a detection is, after one of its rounds ([`detect_with_progress`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Progress {
+    /// Rounds done (each finds the plane of largest consensus among the
+    /// points left and takes out its accepted or rejected patches).
+    pub round: usize,
+    /// Points not yet taken out (explained or discarded).
+    pub points_left: usize,
+    /// Points of the cloud.
+    pub points: usize,
+    /// Primitives accepted so far (before the final merge).
+    pub primitives: usize,
 }
 
 /// The detection cascade: parameters (validated by the caller) and the
@@ -135,6 +168,22 @@ impl<'p> Detector<'p> {
         viewpoint: DVec3,
         rng: Rng,
     ) -> Detection {
+        self.run_inner(pts, origin, viewpoint, rng, &mut |_| {
+            ControlFlow::Continue(())
+        })
+        .0
+    }
+
+    /// The cascade, with `progress` called after each round; the flag:
+    /// stopped by `progress` (the detection is then incomplete and unmerged).
+    fn run_inner(
+        &self,
+        pts: &[Vec3],
+        origin: DVec3,
+        viewpoint: DVec3,
+        rng: Rng,
+        progress: &mut dyn FnMut(&Progress) -> ControlFlow<()>,
+    ) -> (Detection, bool) {
         let (p, policy) = (self.params, &self.policy);
         let t0 = clock::now_ms();
         let floor = (policy.ground == GroundBy::LocalFloor).then(|| FloorGrid::new(pts));
@@ -226,6 +275,15 @@ impl<'p> Detector<'p> {
             rejections = if step.accepted > 0 { 0 } else { rejections + 1 };
             step.time_ms = clock::now_ms() - ts;
             out.steps.push(step);
+            let at = Progress {
+                round: out.steps.len(),
+                points_left: pool.remaining(),
+                points: pts.len(),
+                primitives: out.primitives.len(),
+            };
+            if progress(&at).is_break() {
+                return (out, true);
+            }
         }
         // 7. Merge the pieces of one surface that rounds found apart.
         if policy.merge_pieces && p.hull.merges_detected_pieces() {
@@ -239,6 +297,6 @@ impl<'p> Detector<'p> {
         }
         out.work = pool.work;
         out.time_ms = clock::now_ms() - t0;
-        out
+        (out, false)
     }
 }

@@ -20,6 +20,7 @@
 
 mod convert;
 mod error;
+mod progress;
 mod scenario;
 mod sim;
 

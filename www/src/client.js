@@ -167,12 +167,15 @@ export class PolysceneClient extends EventTarget {
    * One-shot `detect(points, options)` in the worker: a promise of the
    * polygons. `points` is copied (structured clone), so it stays usable here
    * and the call can be sent again if the worker is replaced. `onProgress`
-   * gets `{ stage: 'started', points }` when the worker begins it (also a
-   * 'progress' event). `signal` (an AbortSignal) rejects the promise with
-   * `signal.reason` at once; a call the worker had already been sent is
-   * stopped by replacing the worker (a fresh wasm instance, a few tens of
-   * ms): a run in progress then restarts paused from its first scan, with a
-   * 'reset' event, and other calls are sent again.
+   * (and 'progress' events) hears `{ stage: 'started', points }` when the
+   * worker begins it, then `{ stage: 'round', points, round, pointsLeft,
+   * polygons }` after the cascade's first round and at most every 50 ms.
+   * `signal` (an AbortSignal) rejects the promise with `signal.reason` at
+   * once; a call the worker had already been sent is stopped by replacing
+   * the worker (a fresh wasm instance, a few tens of ms; the running wasm
+   * call cannot hear a message): a run in progress then restarts paused
+   * from its first scan, with a 'reset' event, and other calls are sent
+   * again.
    */
   detect(points, options, { signal, onProgress } = {}) {
     if (signal?.aborted) return Promise.reject(signal.reason);

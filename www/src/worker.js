@@ -38,6 +38,9 @@
 //   { type: 'progress', request, stage: 'started', points }
 //        the worker began a request (messages wait in order until the wasm is
 //        loaded, then each runs to its end)
+//   { type: 'progress', request, stage: 'round', points, round, pointsLeft, polygons }
+//        after a round of the detection cascade (the first, then at most one
+//        per PROGRESS_MS); pointsLeft falls towards 0
 //   { type: 'result', request, polygons?, error?, ms }
 //        the request's answer: polygons (vertices transferred), or an error
 //        message
@@ -51,9 +54,10 @@
 // Back-pressure: at most MAX_IN_FLIGHT scans are posted and not yet acked, so
 // a slow page (software WebGL) never gets a growing queue of scans.
 
-import init, { Scenario, detect, simulate, defaultOptions } from '../pkg/polyscene.js';
+import init, { Scenario, detectWithProgress, simulate, defaultOptions } from '../pkg/polyscene.js';
 
 const MAX_IN_FLIGHT = 2;
+const PROGRESS_MS = 50;
 const IDENTITY = new Float64Array([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]);
 
 const st = {
@@ -237,10 +241,19 @@ function tick() {
 /** A one-shot detection for a 'detect' request: always answers with a 'result'. */
 function runDetect({ request, points, options }) {
   const t0 = performance.now();
-  postMessage({ type: 'progress', request, stage: 'started', points: points?.length ?? 0 });
+  const stride = options?.stride ?? 3;
+  const total = Math.floor((points?.length ?? 0) / stride);
+  postMessage({ type: 'progress', request, stage: 'started', points: total });
+  let last = -Infinity;
+  const onRound = ({ round, pointsLeft, points: n, polygons }) => {
+    const now = performance.now();
+    if (round > 1 && now - last < PROGRESS_MS) return;
+    last = now;
+    postMessage({ type: 'progress', request, stage: 'round', points: n, round, pointsLeft, polygons });
+  };
   let polygons;
   try {
-    polygons = detect(points, options);
+    polygons = detectWithProgress(points, options, onRound);
   } catch (e) {
     if (isTrap(e)) st.fatal = true;
     postMessage({ type: 'result', request, error: `detect: ${msg(e)}`, ms: performance.now() - t0 });

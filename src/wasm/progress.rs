@@ -1,0 +1,96 @@
+//! `detectWithProgress`: one-shot detection that reports after each round to
+//! a JS callback and stops when the callback says so. The callback is called
+//! through js-sys's `Function::call1`, a `catch` import: a callback that
+//! throws ends the detection and its exception is rethrown to the caller,
+//! with no unwinding through the wasm (the module stays usable).
+
+use super::convert::{points_of, polygons_array, DetectOptions};
+use crate::cloud::Cloud;
+use crate::detect::{detect_with_progress, Progress};
+use js_sys::{Array, Function, Object, Reflect};
+use std::ops::ControlFlow;
+use wasm_bindgen::prelude::*;
+
+/// [`detect`](super::detect) that calls `onProgress({ round, pointsLeft,
+/// points, polygons })` after each round of the cascade (`pointsLeft` falls
+/// towards 0; the rounds' count is not known in advance). `onProgress`
+/// returning `false` stops the detection there: it then throws an `Error`
+/// saying so. An exception thrown by `onProgress` ends the detection and is
+/// rethrown as it is. A detection that runs to its end gives what `detect`
+/// gives.
+#[wasm_bindgen(js_name = detectWithProgress, unchecked_return_type = "Polygon[]")]
+pub fn detect_with_progress_js(
+    #[wasm_bindgen(unchecked_param_type = "Float32Array")] points: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "DetectOptions | undefined")] options: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "(progress: DetectProgress) => boolean | void")]
+    on_progress: Function,
+) -> Result<Array, JsValue> {
+    if !on_progress.is_function() {
+        return Err(JsError::new("detectWithProgress: onProgress must be a function").into());
+    }
+    let options = DetectOptions::from_js(&options).map_err(boundary)?;
+    let values = points_of(&points).map_err(boundary)?;
+    let cloud = Cloud::from_flat(&values, options.stride).map_err(boundary)?;
+    let mut thrown: Option<JsValue> = None;
+    let mut last = 0;
+    let mut report = |at: &Progress| {
+        last = at.round;
+        match on_progress.call1(&JsValue::UNDEFINED, &progress_object(at)) {
+            Ok(v) if v == JsValue::FALSE => ControlFlow::Break(()),
+            Ok(_) => ControlFlow::Continue(()),
+            Err(e) => {
+                thrown = Some(e);
+                ControlFlow::Break(())
+            }
+        }
+    };
+    let found = detect_with_progress(&cloud, &options.params, &mut report).map_err(boundary)?;
+    if let Some(e) = thrown {
+        return Err(e);
+    }
+    match found {
+        Some(found) => Ok(polygons_array(&found.primitives)),
+        None => Err(JsError::new(&format!(
+            "detectWithProgress: stopped by onProgress after round {last}"
+        ))
+        .into()),
+    }
+}
+
+/// A core or binding error as the thrown JS `Error` (as every export's).
+fn boundary(e: crate::error::Error) -> JsValue {
+    JsError::from(e).into()
+}
+
+fn progress_object(at: &Progress) -> JsValue {
+    let o = Object::new();
+    for (key, value) in [
+        ("round", at.round),
+        ("pointsLeft", at.points_left),
+        ("points", at.points),
+        ("polygons", at.primitives),
+    ] {
+        // Setting a data property on a fresh plain object cannot fail.
+        let _ = Reflect::set(
+            &o,
+            &JsValue::from_str(key),
+            &JsValue::from_f64(value as f64),
+        );
+    }
+    o.into()
+}
+
+#[wasm_bindgen(typescript_custom_section)]
+const DETECT_PROGRESS_TS: &str = r#"
+/** What `detectWithProgress` reports after each round of the cascade. */
+export interface DetectProgress {
+    /** Rounds done. */
+    round: number;
+    /** Points not yet explained or discarded: falls towards 0. */
+    pointsLeft: number;
+    /** Points of the cloud. */
+    points: number;
+    /** Polygons accepted so far (before the final merge). */
+    polygons: number;
+}
+"#;
