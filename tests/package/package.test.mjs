@@ -11,7 +11,8 @@
 
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { execFileSync, spawnSync } from 'node:child_process';
+import { execFileSync, spawn, spawnSync } from 'node:child_process';
+import net from 'node:net';
 import { createRequire } from 'node:module';
 import fs from 'node:fs';
 import os from 'node:os';
@@ -207,8 +208,8 @@ console.log(n, found, d.minArea, p);
 });
 
 /** Serve `dir`, open `page` in Chromium, wait for window.__results (and a console line matching `waitLog`); return it and the console lines. */
-async function inChromium(dir, { page = 'index.html', waitLog } = {}) {
-  const server = await startServer({ root: dir, port: 0, host: '127.0.0.1' });
+async function inChromium(dir, { page = 'index.html', waitLog, url } = {}) {
+  const server = url ? { url, close: async () => {} } : await startServer({ root: dir, port: 0, host: '127.0.0.1' });
   const context = await browser.newContext();
   const offLoopback = [];
   await context.route((url) => url.origin !== new URL(server.url).origin, (route) => {
@@ -326,6 +327,29 @@ test('Vite: a production build with no config; in Chromium: detect, the README e
   const r = run(path.join(TOOLS, 'vite'), ['build', '--logLevel', 'warn', '--outDir', 'dist', '--emptyOutDir'], { cwd: dir });
   assert.doesNotMatch(r.stdout + r.stderr, /Duplicate member|warn/i, 'Vite builds without warnings');
   checkBrowser(await inChromium(path.join(dir, 'dist'), { waitLog: /^scan 9: / }), 'Vite', { worker: true });
+});
+
+test("Vite's dev server, no config: the same app in Chromium", async () => {
+  const dir = path.join(app, 'vite-app'); // written by the build test above
+  const port = await new Promise((resolve) => {
+    const probe = net.createServer().listen(0, '127.0.0.1', () => {
+      const { port: p } = probe.address();
+      probe.close(() => resolve(p));
+    });
+  });
+  const dev = spawn(path.join(TOOLS, 'vite'), ['--port', String(port), '--strictPort', '--host', '127.0.0.1'], { cwd: dir, stdio: ['ignore', 'pipe', 'pipe'] });
+  let output = '';
+  dev.stdout.on('data', (d) => (output += d));
+  dev.stderr.on('data', (d) => (output += d));
+  try {
+    for (const t0 = Date.now(); !output.includes(`:${port}`); ) {
+      assert.ok(Date.now() - t0 < 30_000 && dev.exitCode === null, `vite dev did not start: ${output}`);
+      await new Promise((r) => setTimeout(r, 100));
+    }
+    checkBrowser(await inChromium(null, { url: `http://127.0.0.1:${port}/`, waitLog: /^scan 9: / }), 'Vite dev', { worker: true });
+  } finally {
+    dev.kill();
+  }
 });
 
 test('esbuild: polyscene/inline with no config, and polyscene with --loader:.wasm=file; in Chromium', async () => {
