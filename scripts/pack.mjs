@@ -15,7 +15,7 @@
 //
 // Every other file or folder under npm/ is copied as it is: a new subpath
 // (say polyscene/geo) is a folder npm/geo/ and one line in npm/package.json's
-// "exports" (and "files" when it is a new top-level folder).
+// "exports" ("files" is written here: every top-level entry of pkg/npm/).
 //
 // The generated JS and .d.ts are patched in two places, each checked here
 // (the script fails when wasm-bindgen's output no longer has the pattern):
@@ -57,10 +57,6 @@ fs.rmSync(out, { recursive: true, force: true });
 fs.cpSync(src, out, { recursive: true });
 for (const f of ['LICENSE-MIT', 'LICENSE-APACHE']) fs.copyFileSync(path.join(root, f), path.join(out, f));
 
-const manifest = JSON.parse(fs.readFileSync(path.join(out, 'package.json'), 'utf8'));
-manifest.version = version;
-manifest.description = description;
-fs.writeFileSync(path.join(out, 'package.json'), `${JSON.stringify(manifest, null, 2)}\n`);
 
 /** Remove wasm-bindgen's own free() from every class that also has ours. */
 function dedupeFreeJs(js, file) {
@@ -200,6 +196,23 @@ for (const f of ['worker.js', 'client.js']) {
   write(`worker/${f}`, text);
 }
 
+// The manifest: version and description from Cargo.toml; "files" is every
+// top-level entry assembled here (npm adds package.json itself).
+const manifest = JSON.parse(fs.readFileSync(path.join(out, 'package.json'), 'utf8'));
+manifest.version = version;
+manifest.description = description;
+manifest.files = fs
+  .readdirSync(out, { withFileTypes: true })
+  .filter((e) => e.name !== 'package.json')
+  .map((e) => (e.isDirectory() ? `${e.name}/` : e.name))
+  .sort();
+fs.writeFileSync(path.join(out, 'package.json'), `${JSON.stringify(manifest, null, 2)}\n`);
+for (const [subpath, target] of Object.entries(manifest.exports)) {
+  for (const file of typeof target === 'string' ? [target] : JSON.stringify(target).match(/"\.\/[^"]+"/g).map((q) => JSON.parse(q))) {
+    if (!fs.existsSync(path.join(out, file))) fail(`exports["${subpath}"] names ${file}, which is missing`);
+  }
+}
+
 // Nothing that points nowhere.
 for (const file of fs.readdirSync(out, { recursive: true })) {
   const p = path.join(out, file);
@@ -211,9 +224,6 @@ for (const file of fs.readdirSync(out, { recursive: true })) {
       if (!/^(https?:|mailto:|#)/.test(link)) fail(`${file}: relative link ${link} (it breaks on the registry's page)`);
     }
   }
-}
-for (const file of manifest.files) {
-  if (!fs.existsSync(path.join(out, file))) fail(`package.json "files" names ${file}, which is missing`);
 }
 
 const packed = JSON.parse(
