@@ -58,7 +58,7 @@ class App {
       restart: () => this.restart(),
       openFiles: () => $('file-input').click(),
     };
-    this.geo = { enabled: false, lat: 49.0069, lon: 8.4037, alt: 115 };
+    this.geo = { enabled: false, lat: 49.0069, lon: 8.4037, alt: 115, heading: 90 };
     this.fileSources = new Map(); // GUI name -> { label, scans, id }
     this.loads = 0;
     this.latest = { polygons: [], mesh: null, report: null, index: -1, total: 0 };
@@ -379,6 +379,7 @@ class App {
     geo.add(this.geo, 'lat', -90, 90).name('latitude (°)').decimals(7);
     geo.add(this.geo, 'lon', -180, 180).name('longitude (°)').decimals(7);
     geo.add(this.geo, 'alt', -500, 9000).name('altitude (m)').decimals(2);
+    geo.add(this.geo, 'heading', 0, 360).name('heading of +x (°)').decimals(2);
     geo.close();
     exp.close();
     if (window.innerHeight < 820) view.close();
@@ -545,8 +546,8 @@ class App {
       if (kind === 'json') {
         download(toJSON(polys, { source: $('source-label').textContent, scans: this.latest.index + 1, options: this.options }), `${stamp}.json`, 'application/json');
       } else if (kind === 'geojson') {
-        const origin = this.geo.enabled ? { lat: this.geo.lat, lon: this.geo.lon, alt: this.geo.alt } : null;
-        download(toGeoJSON(polys, origin), `${stamp}.geojson`, 'application/geo+json');
+        const frame = this.geo.enabled ? { origin: { lat: this.geo.lat, lon: this.geo.lon, alt: this.geo.alt }, heading: this.geo.heading } : null;
+        download(toGeoJSON(polys, frame), `${stamp}.geojson`, 'application/geo+json');
       } else if (kind === 'glb') {
         if (!this.latest.mesh) throw new Error('no mesh yet');
         download(await toGLB(this.latest.mesh, polys), `${stamp}.glb`, 'model/gltf-binary');
