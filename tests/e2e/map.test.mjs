@@ -4,11 +4,12 @@
 // refused and reported).
 //
 // The known corner: a snapshot made here with the Node package (pkg/node)
-// after 5 scans of the simulated drive; its largest ground polygon's first
-// vertex, in world metres, is placed by hand (WGS84 radii of curvature at the
-// origin, not polyscene/geo) at a lon/lat, which the map's source data must
-// hold to 1 cm, and the map must draw that polygon under the screen point it
-// projects an interior point of the polygon to.
+// after 5 scans of the simulated drive; its largest ground polygon's vertex
+// farthest from the origin, in world metres, is placed by hand (WGS84 radii
+// of curvature at the origin, not polyscene/geo) at a lon/lat, which the
+// map's source data must hold to 1 cm (a heading 0.02 degrees off fails),
+// and the map must draw that polygon under the screen point it projects an
+// interior point of the polygon to.
 
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
@@ -106,7 +107,12 @@ before(async () => {
     const area = Math.abs((v[1][0] - v[0][0]) * (v[2][1] - v[0][1]) - (v[2][0] - v[0][0]) * (v[1][1] - v[0][1])) / 2;
     if (!best || area > best.area) best = { area, c: [0, 1, 2].map((a) => (v[0][a] + v[1][a] + v[2][a]) / 3) };
   }
-  known = { id: ground.id, corner: [...ground.vertices.subarray(0, 3)], inside: best.c, count: polygons.length };
+  // Its corner farthest from the origin: the most sensitive to a wrong heading.
+  let far = 0;
+  for (let i = 0; i < ground.vertices.length; i += 3) {
+    if (Math.hypot(ground.vertices[i], ground.vertices[i + 1]) > Math.hypot(ground.vertices[far], ground.vertices[far + 1])) far = i;
+  }
+  known = { id: ground.id, vertex: far / 3, corner: [...ground.vertices.subarray(far, far + 3)], inside: best.c, count: polygons.length };
   snapshotFile = path.join(scratch, 'drive-snapshot.json');
   writeFileSync(snapshotFile, s.toJSONString());
   s.free();
@@ -178,7 +184,7 @@ test('a snapshot on the map: the known ground corner at its lon/lat (1 cm), draw
   const expectedCorner = lonLatByHand(known.corner[0], known.corner[1]);
   const inside = lonLatByHand(known.inside[0], known.inside[1]);
   const got = await page.evaluate(
-    async ({ id, inside }) => {
+    async ({ id, vertex, inside }) => {
       const { map, state } = window.polysceneMap;
       const data = await map.getSource('footprints').getData();
       const f = data.features.find((x) => x.properties.id === id);
@@ -186,9 +192,9 @@ test('a snapshot on the map: the known ground corner at its lon/lat (1 cm), draw
       const p = map.project(inside);
       const c = map.getCanvas();
       const hits = map.queryRenderedFeatures([p.x, p.y], { layers: ['ground'] }).map((x) => x.properties.id);
-      return { count: data.features.length, kind: f?.properties.kind, corner: f?.geometry.coordinates[0][0], point: [p.x, p.y], size: [c.clientWidth, c.clientHeight], hits, scans: state.scans };
+      return { count: data.features.length, kind: f?.properties.kind, corner: f?.geometry.coordinates[0][vertex], point: [p.x, p.y], size: [c.clientWidth, c.clientHeight], hits, scans: state.scans };
     },
-    { id: known.id, inside },
+    { id: known.id, vertex: known.vertex, inside },
   );
   assert.equal(got.count, known.count, 'one feature per polygon of the snapshot');
   assert.equal(got.scans, 5);
@@ -198,6 +204,40 @@ test('a snapshot on the map: the known ground corner at its lon/lat (1 cm), draw
   assert.ok(got.point[0] > 0 && got.point[1] > 0 && got.point[0] < got.size[0] && got.point[1] < got.size[1], `inside point on screen: ${got.point}`);
   assert.ok(got.hits.includes(known.id), `the map draws polygon ${known.id} at ${got.point}: hits ${got.hits}`);
   await page.screenshot({ path: path.join(OUT, 'map-snapshot.png') });
+  await page.close();
+});
+
+test('a KITTI .bin on the map: polygons around the origin of the form; a bad file says so', { timeout: 60_000 }, async () => {
+  const page = await context.newPage();
+  await page.goto(mapUrl(), { waitUntil: 'load' });
+  await page.waitForFunction(() => window.polysceneMap?.state.mapReady, null, { timeout: 30_000 });
+  // A new origin through the form: the scan's sensor (world 0, 0, 0) is placed there.
+  await page.fill('#f-lat', '-33.8688');
+  await page.fill('#f-lon', '151.2093');
+  await page.fill('#f-alt', '20');
+  await page.fill('#f-heading', '0');
+  await page.click('#frame-form button[type=submit]');
+  await page.setInputFiles('#scan-input', path.join(WWW, 'data/ouster_os1_64_legacy_f12073.bin'));
+  await page.waitForFunction(
+    () => window.polysceneMap.state.source.includes('ouster_os1_64_legacy_f12073.bin') && window.polysceneMap.state.scans === 1,
+    null,
+    { timeout: 45_000 },
+  );
+  const got = await page.evaluate(async () => {
+    const { map } = window.polysceneMap;
+    const vehicle = await map.getSource('vehicle').getData();
+    const footprints = await map.getSource('footprints').getData();
+    return { vehicle: vehicle.geometry.coordinates, rings: footprints.features.map((f) => f.geometry.coordinates[0]) };
+  });
+  assert.ok(Math.abs(got.vehicle[0] - 151.2093) < 1e-9 && Math.abs(got.vehicle[1] + 33.8688) < 1e-9, `sensor at ${got.vehicle}`);
+  assert.ok(got.rings.length > 3, `${got.rings.length} polygons`);
+  for (const ring of got.rings) {
+    for (const [lon, lat] of ring) assert.ok(Math.abs(lon - 151.2093) < 0.003 && Math.abs(lat + 33.8688) < 0.003, `${lon}, ${lat} is far from the origin`);
+  }
+  const bad = path.join(scratch, 'broken.bin');
+  writeFileSync(bad, Buffer.alloc(16 * 10 + 4, 1));
+  await page.setInputFiles('#scan-input', bad);
+  await page.locator('.toast.error', { hasText: 'broken.bin' }).waitFor({ timeout: 10_000 });
   await page.close();
 });
 
