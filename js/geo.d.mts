@@ -120,8 +120,11 @@ export interface PolygonCollection {
 /** GeoJSON (RFC 7946), 3D positions [lon, lat, height], walls as 3D polygons with kind "wall". */
 export declare function toGeoJSON(polygons: Polygons, frame: GeoFrame): PolygonCollection;
 
-/** 2D footprints in lon/lat for a map; walls as thin rectangles with base / height (m) for an extrusion. */
-export declare function mapFeatures(polygons: Polygons, frame: GeoFrame, options?: { wallThickness?: number }): PolygonCollection;
+/**
+ * 2D footprints in lon/lat for a map; walls as thin rectangles with base / height (m above
+ * `groundHeight`, default the lowest ground vertex) for an extrusion.
+ */
+export declare function mapFeatures(polygons: Polygons, frame: GeoFrame, options?: { wallThickness?: number; groundHeight?: number }): PolygonCollection;
 
 /** The triangle mesh of `scenario.mesh()`. */
 export interface MeshLike {

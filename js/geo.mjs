@@ -277,14 +277,31 @@ export function toGeoJSON(polygons, frame) {
  * What a 2D map draws: a FeatureCollection of footprints in lon/lat. Ground
  * and other polygons: their outline (2D). Walls: a thin rectangle along the
  * wall's horizontal extent (`wallThickness`, m, default 0.3) with `base` and
- * `height` properties (m above the frame's horizontal, base clamped at 0) for
- * an extrusion (MapLibre's fill-extrusion-base / fill-extrusion-height).
+ * `height` properties (m above `groundHeight`, base clamped at 0) for an
+ * extrusion (MapLibre's fill-extrusion-base / fill-extrusion-height).
+ * `groundHeight` (m, in the frame's heights) defaults to the lowest vertex of
+ * the ground polygons (of all polygons when none is ground), so walls stand
+ * on the map whether the world's zero is the road, the sensor or sea level.
  * Every feature has id, kind and area (the polygon's own area).
  */
-export function mapFeatures(polygons, frame, { wallThickness = 0.3 } = {}) {
+export function mapFeatures(polygons, frame, { wallThickness = 0.3, groundHeight } = {}) {
   if (!frame?.toLonLat) throw new TypeError('polyscene/geo: mapFeatures needs a frame from geoFrame(...)');
+  finite(wallThickness, 'wallThickness');
+  const rows = polygonRows(polygons);
+  if (groundHeight === undefined) {
+    const lowest = (list) => {
+      let m = Infinity;
+      for (const p of list) for (let i = 0; i < p.vertices.length; i += 3) m = Math.min(m, frame.up(p.vertices[i], p.vertices[i + 1], p.vertices[i + 2]));
+      return m;
+    };
+    const ground = rows.filter((p) => p.kind === 'ground');
+    groundHeight = lowest(ground.length ? ground : rows);
+    if (!Number.isFinite(groundHeight)) groundHeight = 0;
+  } else {
+    finite(groundHeight, 'groundHeight');
+  }
   const features = [];
-  for (const p of polygonRows(polygons)) {
+  for (const p of rows) {
     const v = p.vertices;
     const n = v.length / 3;
     const props = { id: p.id, kind: p.kind, area: r3(p.area ?? ringArea3D(v)) };
@@ -309,8 +326,8 @@ export function mapFeatures(polygons, frame, { wallThickness = 0.3 } = {}) {
       const h = wallThickness / 2;
       const at = (t, o) => [t * tx + (s + o) * mx, t * ty + (s + o) * my];
       ring = [at(t0, -h), at(t1, -h), at(t1, h), at(t0, h)].map(([x, y]) => frame.toLonLat(x, y, 0));
-      props.base = r3(Math.max(0, zmin));
-      props.height = r3(Math.max(props.base, zmax));
+      props.base = r3(Math.max(0, zmin - groundHeight));
+      props.height = r3(Math.max(props.base, zmax - groundHeight));
     } else {
       ring = [];
       for (let i = 0; i < n; i++) ring.push(frame.toLonLat(v[3 * i], v[3 * i + 1], v[3 * i + 2]));

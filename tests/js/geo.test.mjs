@@ -173,6 +173,16 @@ test("map footprints: outlines for the ground, thin extrudable rectangles for wa
   // 10 m long, 0.4 m thick, centred on y = 8.
   assert.ok(Math.abs(geo.ringArea3D(xyz) - 4) < 0.01, `footprint area ${geo.ringArea3D(xyz)}`);
   for (let i = 0; i < 4; i++) assert.ok(Math.abs(Math.abs(xyz[3 * i + 1] - 8) - 0.2) < 1e-3);
+  // World zero at the sensor, 1.73 m above the road (KITTI): walls still stand on the ground.
+  const lift = (p, dz) => ({ ...p, vertices: p.vertices.map((v, i) => (i % 3 === 2 ? v + dz : v)) });
+  const kitti = geo.mapFeatures([lift(GROUND, -1.73), lift(WALL, -1.73)], f).features[1].properties;
+  assert.deepEqual([kitti.base, kitti.height], [0, 3]);
+  // Map coordinates with heights above sea level.
+  const utm = geo.geoFrame({ crs: "EPSG:32632", offset: [500000, 4982000, 0] });
+  const asl = geo.mapFeatures([lift(GROUND, 250), lift(WALL, 250)], utm).features[1].properties;
+  assert.deepEqual([asl.base, asl.height], [0, 3]);
+  const given = geo.mapFeatures([WALL], f, { groundHeight: -1 }).features[0].properties;
+  assert.deepEqual([given.base, given.height], [1, 4]);
 });
 
 test("glTF: a valid .glb (header, chunks, buffer views and accessors within their lengths)", () => {
