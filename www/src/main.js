@@ -244,6 +244,9 @@ class App {
     this.latest.polygons = m.polygons;
     this.latest.mesh = m.mesh;
     this.latest.index = m.scans - 1;
+    // The GUI shows the snapshot's options (a restart runs with them).
+    for (const k of Object.keys(this.options)) if (m.options && k in m.options) this.options[k] = m.options[k];
+    this.gui?.controllersRecursive().forEach((c) => c.updateDisplay());
     // No scan, no vehicle: centre the view on the polygons (their mean
     // vertex, in whole metres, keeps the local f32 coordinates small).
     const c = [0, 0, 0];
