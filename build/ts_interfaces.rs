@@ -84,6 +84,13 @@ const INTERFACES: &[Interface] = &[
         flatten: &[],
     },
     Interface {
+        ts: "FlatPolygons",
+        file: "src/wasm/flat.rs",
+        rust: "FlatPolygonsView",
+        optional: false,
+        flatten: &[],
+    },
+    Interface {
         ts: "SimulatedScan",
         file: "src/wasm/convert.rs",
         rust: "ScanView",
@@ -321,7 +328,7 @@ fn ts_type(rust: &str, types: &Types) -> String {
         "bool" => "boolean".into(),
         "String" | "&str" | "&'static str" => "string".into(),
         "DVec3" => "[number, number, number]".into(),
-        "Float32Array" | "Float64Array" | "Uint32Array" => rust.into(),
+        "Float32Array" | "Float64Array" | "Uint32Array" | "Uint8Array" => rust.into(),
         // The binding's input types (src/wasm/convert.rs).
         "Stride" => "3 | 4".into(),
         "Pose" => "Float64Array | Float32Array | number[] | { elements: ArrayLike<number> }".into(),

@@ -12,6 +12,8 @@
 //                       web/polyscene_bg.wasm, the same file), polyscene.mjs (its
 //                       ES module face: one wasm instance for both)
 //     worker/           www/src/worker.js and client.js (polyscene/worker), index.js
+//     geo/              js/geo.mjs and js/geo.d.mts as index.js, index.d.ts (polyscene/geo;
+//                       the package's one dependency, proj4, is for it)
 //
 // Every other file or folder under npm/ is copied as it is: a new subpath
 // (say polyscene/geo) is a folder npm/geo/ and one line in npm/package.json's
@@ -195,6 +197,10 @@ for (const f of ['worker.js', 'client.js']) {
   }
   write(`worker/${f}`, text);
 }
+
+// geo/: polyscene/geo (js/geo.mjs, its types js/geo.d.mts), unchanged.
+write('geo/index.js', read('js/geo.mjs'));
+write('geo/index.d.ts', read('js/geo.d.mts'));
 
 // The manifest: version and description from Cargo.toml; "files" is every
 // top-level entry assembled here (npm adds package.json itself).

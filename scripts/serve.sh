@@ -2,7 +2,9 @@
 # Serve the demo page (www/) on http://127.0.0.1:PORT (default 8080), loopback only.
 #   scripts/serve.sh [PORT]
 # www/node_modules (three.js, lil-gui) and www/pkg (the wasm package, made by
-# scripts/build-wasm.sh) are served from inside www/, so the page needs no internet.
+# scripts/build-wasm.sh) are served from inside www/, and the package's JS
+# modules (js/, e.g. js/geo.mjs for the map page) under /js/, so the pages need
+# no internet. Pages: / (the 3D view) and /map.html (the map dashboard).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 PORT="${1:-${PORT:-8080}}"
@@ -11,8 +13,9 @@ if [ ! -f www/pkg/polyscene.js ] || [ ! -f www/pkg/polyscene_bg.wasm ]; then
   echo "serve: www/pkg/polyscene.js or polyscene_bg.wasm is missing; run scripts/build-wasm.sh (or make demo) first" >&2
   exit 1
 fi
-if [ ! -f www/node_modules/three/build/three.module.js ] || [ ! -f www/node_modules/lil-gui/dist/lil-gui.esm.js ]; then
+if [ ! -f www/node_modules/three/build/three.module.js ] || [ ! -f www/node_modules/lil-gui/dist/lil-gui.esm.js ] ||
+  [ ! -f www/node_modules/maplibre-gl/dist/maplibre-gl.mjs ] || [ ! -f www/node_modules/proj4/dist/proj4-src.js ]; then
   echo "serve: www/node_modules is incomplete; run scripts/setup.sh npm (or make demo) first" >&2
   exit 1
 fi
-exec node www/tools/static-server.mjs --root www --port "$PORT" --host 127.0.0.1
+exec node www/tools/static-server.mjs --root www --mount /js/=js --port "$PORT" --host 127.0.0.1

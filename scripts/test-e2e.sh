@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The browser test of the demo page: headless Chromium (Debian's, through
+# The browser tests of the demo page and the map page: headless Chromium (Debian's, through
 # playwright-core) drives www/ served on a free loopback port.
 #   scripts/test-e2e.sh
 # Needs scripts/setup.sh all (chromium, www/node_modules); builds www/pkg if missing.
@@ -21,5 +21,5 @@ if [ ! -d www/node_modules/playwright-core ]; then
 fi
 mkdir -p target/e2e
 # Each wait inside the test has its own timeout; this bounds the whole run.
-timeout --kill-after=15 240 node --test --test-reporter=spec tests/e2e/
+timeout --kill-after=15 360 node --test --test-reporter=spec tests/e2e/
 echo "test-e2e: screenshots in target/e2e/"

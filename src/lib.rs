@@ -17,6 +17,7 @@ pub mod cloud;
 pub mod detect;
 pub mod error;
 pub mod eval;
+pub mod flat;
 pub mod geometry;
 pub mod io;
 pub mod mesh;

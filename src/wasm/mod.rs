@@ -6,6 +6,7 @@
 //!   plain JS objects out; its structs define the `.d.ts` interfaces, which
 //!   `build.rs` generates from them;
 //! - [`error`]: the boundary's error type, so that `?` converts;
+//! - [`flat`]: polygons as columns (`polygonsFlat`, `detectFlat`);
 //! - [`scenario`]: the `Scenario` class;
 //! - [`sim`]: `simulate`, `Simulation` and its iterator;
 //! - here: the module start, `detect`, `defaultOptions`, `version`.
@@ -20,6 +21,7 @@
 
 mod convert;
 mod error;
+mod flat;
 mod progress;
 mod scenario;
 mod sim;

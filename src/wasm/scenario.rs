@@ -27,7 +27,7 @@ pub struct JsScenario {
 }
 
 impl JsScenario {
-    fn get(&self) -> Result<&Scenario> {
+    pub(super) fn get(&self) -> Result<&Scenario> {
         self.inner.as_ref().ok_or_else(|| invalid(FREED_SCENARIO))
     }
 

@@ -58,7 +58,7 @@ before(async () => {
   mkdirSync(OUT, { recursive: true });
   scratch = mkdtempSync(path.join(os.tmpdir(), 'polyscene-e2e-'));
   profile = path.join(scratch, 'profile');
-  server = await startServer({ root: WWW, port: 0, host: '127.0.0.1' });
+  server = await startServer({ root: WWW, port: 0, host: '127.0.0.1', mounts: { '/js/': path.join(ROOT, 'js') } });
   context = await chromium.launchPersistentContext(profile, {
     executablePath: CHROMIUM,
     headless: true,
@@ -305,7 +305,7 @@ test('exports: JSON, GeoJSON (with a geographic origin), glTF and OBJ', { timeou
     for (const [lon, lat] of ring) {
       assert.ok(Math.abs(lon - 8.4037) < 0.01 && Math.abs(lat - 49.0069) < 0.01, `${lon}, ${lat} is not near the origin`);
     }
-    for (const k of ['id', 'area', 'normal', 'ground']) assert.ok(k in f.properties, `property ${k}`);
+    for (const k of ['id', 'kind', 'area', 'normal', 'ground']) assert.ok(k in f.properties, `property ${k}`);
   }
 
   const glb = await save('glTF');

@@ -104,7 +104,7 @@ after(async () => {
 
 test('the tarball: one package, licences, types, an exports map, no placeholder URL', () => {
   const files = execFileSync('tar', ['tzf', tarball], { encoding: 'utf8' }).split('\n').filter(Boolean);
-  for (const f of ['LICENSE-MIT', 'LICENSE-APACHE', 'README.md', 'web/polyscene.d.ts', 'web/polyscene_bg.wasm', 'node/polyscene.cjs', 'worker/worker.js']) {
+  for (const f of ['LICENSE-MIT', 'LICENSE-APACHE', 'README.md', 'web/polyscene.d.ts', 'web/polyscene_bg.wasm', 'node/polyscene.cjs', 'worker/worker.js', 'geo/index.js', 'geo/index.d.ts']) {
     assert.ok(files.includes(`package/${f}`), `${f} in the tarball`);
   }
   assert.equal(files.filter((f) => f.endsWith('.wasm')).length, 1, 'one copy of the wasm');
@@ -122,6 +122,28 @@ test('the tarball: one package, licences, types, an exports map, no placeholder 
   }
   const readme = fs.readFileSync(path.join(dir, 'README.md'), 'utf8');
   for (const [, link] of readme.matchAll(/\]\(([^)]+)\)/g)) assert.match(link, /^https?:/, `README link ${link}`);
+});
+
+test('Node ESM: polyscene/geo places a detected polygon at its lon/lat (proj4 installed as a dependency)', () => {
+  fs.writeFileSync(
+    path.join(app, 'geo.mjs'),
+    `import { detect } from "polyscene";
+     import { geoFrame, toGeoJSON } from "polyscene/geo";
+     import { plane } from "./plane.mjs";
+     const frame = geoFrame({ origin: { lon: 8.4037, lat: 49.0069, alt: 115 }, heading: 90 });
+     const fc = toGeoJSON(detect(plane(), { stride: 3 }), frame);
+     console.log(JSON.stringify(fc.features.map((f) => f.geometry.coordinates[0])));`,
+  );
+  const rings = JSON.parse(run('node', ['geo.mjs']).stdout);
+  assert.equal(rings.length, 1, 'one polygon');
+  // x is east (heading 90): the plane's x from 2 to 12 m is 2 to 12 m east of the origin,
+  // its y from -3 to 3 m as far north and south (a metre of longitude there: 111,320 cos(lat) m a degree).
+  const east = (lon) => (lon - 8.4037) * 111320 * Math.cos((49.0069 * Math.PI) / 180);
+  const north = (lat) => (lat - 49.0069) * 110_900;
+  const es = rings[0].map(([lon]) => east(lon));
+  const ns = rings[0].map(([, lat]) => north(lat));
+  assert.ok(Math.min(...es) > 1.5 && Math.min(...es) < 2.5 && Math.max(...es) > 11.5 && Math.max(...es) < 12.5, `east ${es}`);
+  assert.ok(Math.min(...ns) > -3.5 && Math.max(...ns) < 3.5, `north ${ns}`);
 });
 
 test("the package README's examples are the README's", () => {

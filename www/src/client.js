@@ -11,8 +11,8 @@
 // Anything may be called at once: the worker keeps every message until its
 // wasm is loaded (`client.ready` resolves then, with the option defaults).
 // Events (detail = the worker's message, see the PROTOCOL in worker.js):
-// 'ready', 'reset', 'scan', 'state', 'error', 'progress'. Messages of an
-// earlier run (sent before the last configure) are dropped here, so
+// 'ready', 'reset', 'scan', 'restored', 'state', 'error', 'progress'. Messages
+// of an earlier run (sent before the last configure) are dropped here, so
 // listeners never see a scan of a run that was replaced. Each 'scan' is
 // acknowledged after the listeners ran, which is the worker's back-pressure.
 
@@ -133,6 +133,20 @@ export class PolysceneClient extends EventTarget {
     if (play !== undefined) m.play = play;
     // Kept (with the source) to replay after a worker restart.
     this.lastConfigure = { ...m, source: source || this.lastConfigure?.source };
+    this.#post(m);
+    return run;
+  }
+
+  /**
+   * Replace the run by a scenario restored from a snapshot (`json`: the text
+   * of `scenario.toJSONString()` / a saved snapshot file). Answered by 'reset',
+   * 'restored' (polygons, mesh) and 'state', or by 'error' naming `label`.
+   * Returns the run number.
+   */
+  restore(json, label = 'snapshot') {
+    const run = ++this.run;
+    const m = { type: 'restore', run, json: String(json), label };
+    this.lastConfigure = m;
     this.#post(m);
     return run;
   }

@@ -1,10 +1,12 @@
-// Exports of the current polygons: JSON, GeoJSON, glTF (.glb) and OBJ.
+// Exports of the current polygons: JSON, GeoJSON (through polyscene/geo),
+// glTF (.glb) and OBJ.
 // The polygons are what Scenario.polygons() returned; the mesh is
 // Scenario.mesh(). Downloads go through a Blob and a temporary link.
 
 import * as THREE from 'three';
 import { GLTFExporter } from 'three/addons/exporters/GLTFExporter.js';
 import { OBJExporter } from 'three/addons/exporters/OBJExporter.js';
+import { geoFrame, kindOf, toGeoJSON as geoJSON } from 'polyscene/geo';
 import { idColor } from './palette.js';
 
 const round = (v, k) => Math.round(v * k) / k;
@@ -41,30 +43,19 @@ export function toJSON(polygons, meta = {}) {
 }
 
 /**
- * Local east/north metres to WGS84 lon/lat around a geographic origin (the
- * world point (0, 0, 0)): a local tangent plane with the ellipsoid's radii of
- * curvature at the origin's latitude. Good to centimetres within a few km.
+ * GeoJSON FeatureCollection, one Polygon Feature per polygon with 3D
+ * positions. With `frame` ({ origin: { lat, lon, alt }, heading }, or
+ * { crs }: see polyscene/geo's geoFrame) the coordinates are WGS84
+ * [lon, lat, height] through polyscene/geo: walls stay 3D polygons, every
+ * feature has a `kind` (ground, wall, other). Without it they stay local
+ * metres [x, y, z] and the collection says so.
  */
-export function tangentPlane({ lat, lon, alt = 0 }) {
-  const a = 6378137.0;
-  const e2 = 6.69437999014e-3;
-  const phi = (lat * Math.PI) / 180;
-  const s = Math.sin(phi);
-  const w = 1 - e2 * s * s;
-  const M = (a * (1 - e2)) / (w * Math.sqrt(w)); // meridional radius
-  const N = a / Math.sqrt(w); // prime vertical radius
-  const k = 180 / Math.PI;
-  return (x, y, z) => [round(lon + (x / (N * Math.cos(phi))) * k, 1e9), round(lat + (y / M) * k, 1e9), round(alt + z, 1e3)];
-}
-
-/**
- * GeoJSON FeatureCollection, one Polygon Feature per polygon, properties id,
- * area, normal, ground (+ support, bornScan, lastScan). With `origin`
- * ({ lat, lon, alt }) the coordinates are [lon, lat, height]; without it they
- * stay local metres [x, y, z] and the collection says so.
- */
-export function toGeoJSON(polygons, origin = null) {
-  const project = origin ? tangentPlane(origin) : (x, y, z) => [round(x, 1e3), round(y, 1e3), round(z, 1e3)];
+export function toGeoJSON(polygons, frame = null) {
+  if (frame) {
+    const fc = geoJSON(polygons, geoFrame(frame));
+    for (const f of fc.features) f.properties.ground = f.properties.kind === 'ground';
+    return JSON.stringify(fc);
+  }
   const features = polygons.map((p) => {
     let r = ring(p);
     // Right-hand rule (RFC 7946): exterior rings counter-clockwise seen from above.
@@ -74,8 +65,9 @@ export function toGeoJSON(polygons, origin = null) {
       const [x1, y1] = r[(i + 1) % r.length];
       s += x0 * y1 - x1 * y0;
     }
-    if (s < 0) r = r.reverse();
-    const coords = r.map(([x, y, z]) => project(x, y, z));
+    const kind = kindOf(p);
+    if (s < 0 && kind !== 'wall') r = r.reverse();
+    const coords = r.map(([x, y, z]) => [round(x, 1e3), round(y, 1e3), round(z, 1e3)]);
     coords.push(coords[0].slice());
     return {
       type: 'Feature',
@@ -83,6 +75,7 @@ export function toGeoJSON(polygons, origin = null) {
       geometry: { type: 'Polygon', coordinates: [coords] },
       properties: {
         id: p.id,
+        kind,
         area: round(p.area, 1e3),
         normal: p.normal.map((v) => round(v, 1e6)),
         ground: p.ground,
@@ -92,15 +85,13 @@ export function toGeoJSON(polygons, origin = null) {
       },
     };
   });
-  const fc = { type: 'FeatureCollection', features };
-  if (!origin) {
-    fc.polyscene = {
-      coordinates: 'local metres: x east, y north, z up (no geographic origin was set; set one to get WGS84 lon/lat)',
-    };
-  } else {
-    fc.polyscene = { origin, coordinates: 'WGS84 lon, lat; height = origin altitude + z (m)' };
-  }
-  return JSON.stringify(fc);
+  return JSON.stringify({
+    type: 'FeatureCollection',
+    features,
+    polyscene: {
+      coordinates: 'local metres [x, y, z], z up (no geographic frame was set; set an origin and heading to get WGS84 lon/lat)',
+    },
+  });
 }
 
 /**

@@ -58,7 +58,7 @@ class App {
       restart: () => this.restart(),
       openFiles: () => $('file-input').click(),
     };
-    this.geo = { enabled: false, lat: 49.0069, lon: 8.4037, alt: 115 };
+    this.geo = { enabled: false, lat: 49.0069, lon: 8.4037, alt: 115, heading: 90 };
     this.fileSources = new Map(); // GUI name -> { label, scans, id }
     this.loads = 0;
     this.latest = { polygons: [], mesh: null, report: null, index: -1, total: 0 };
@@ -152,6 +152,7 @@ class App {
     const c = this.client;
     c.addEventListener('reset', (e) => this.#onReset(e.detail));
     c.addEventListener('scan', (e) => this.#onScan(e.detail));
+    c.addEventListener('restored', (e) => this.#onRestored(e.detail));
     c.addEventListener('state', (e) => {
       this.done = e.detail.done;
       this.#setPlaying(e.detail.playing);
@@ -236,6 +237,42 @@ class App {
       const p = m.polygons.find((q) => q.id === this.picked);
       this.#showPick(p || null, !p);
     }
+  }
+
+  /** A restored snapshot: its polygons and surfaces, no scan points. */
+  #onRestored(m) {
+    this.latest.polygons = m.polygons;
+    this.latest.mesh = m.mesh;
+    this.latest.index = m.scans - 1;
+    // The GUI shows the snapshot's options (a restart runs with them).
+    for (const k of Object.keys(this.options)) if (m.options && k in m.options) this.options[k] = m.options[k];
+    this.gui?.controllersRecursive().forEach((c) => c.updateDisplay());
+    // No scan, no vehicle: centre the view on the polygons (their mean
+    // vertex, in whole metres, keeps the local f32 coordinates small).
+    const c = [0, 0, 0];
+    let n = 0;
+    let zmin = Infinity;
+    for (const p of m.polygons) {
+      for (let i = 0; i < p.vertices.length; i += 3) {
+        c[0] += p.vertices[i];
+        c[1] += p.vertices[i + 1];
+        c[2] += p.vertices[i + 2];
+        zmin = Math.min(zmin, p.vertices[i + 2]);
+        n++;
+      }
+    }
+    if (n > 0) {
+      const at = [c[0] / n, c[1] / n, zmin + 1.8];
+      this.view.origin = at.map(Math.round);
+      this.view.vehiclePose = new Float64Array([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, at[0], at[1], at[2], 1]);
+      this.view.snapCamera = true;
+    }
+    this.view.setPolygons(m.polygons);
+    this.view.setMesh(m.mesh);
+    const area = m.polygons.reduce((a, p) => a + p.area, 0);
+    this.#setStat('stat-polygons', m.polygons.length, fmt.int(m.polygons.length));
+    this.#setStat('stat-scan', m.scans, `snapshot after ${fmt.int(m.scans)} scans · ${fmt.area(area)}`);
+    $('progress-fill').style.width = '100%';
   }
 
   #setStat(id, value, text) {
@@ -332,17 +369,20 @@ class App {
       glb: () => this.#export('glb'),
       obj: () => this.#export('obj'),
       snapshot: () => this.#export('snapshot'),
+      loadSnapshot: () => $('snapshot-input').click(),
     };
     exp.add(actions, 'json').name('polygons · JSON');
     exp.add(actions, 'geojson').name('polygons · GeoJSON');
     exp.add(actions, 'glb').name('surfaces · glTF (.glb)');
     exp.add(actions, 'obj').name('surfaces · OBJ');
     exp.add(actions, 'snapshot').name('scenario snapshot');
+    exp.add(actions, 'loadSnapshot').name('load a snapshot…');
     const geo = exp.addFolder('Geographic origin (GeoJSON)');
     geo.add(this.geo, 'enabled').name('use origin');
     geo.add(this.geo, 'lat', -90, 90).name('latitude (°)').decimals(7);
     geo.add(this.geo, 'lon', -180, 180).name('longitude (°)').decimals(7);
     geo.add(this.geo, 'alt', -500, 9000).name('altitude (m)').decimals(2);
+    geo.add(this.geo, 'heading', 0, 360).name('heading of +x (°)').decimals(2);
     geo.close();
     exp.close();
     if (window.innerHeight < 820) view.close();
@@ -367,8 +407,34 @@ class App {
 
   // ------------------------------------------------------------ files
 
+  /** Restore a saved snapshot (a .json file from "scenario snapshot"). */
+  async loadSnapshot(file) {
+    let text;
+    try {
+      text = await file.text();
+      const o = JSON.parse(text);
+      if (!o || typeof o !== 'object' || !('params' in o)) throw new Error('it is JSON, but not a polyscene snapshot (no "params")');
+    } catch (e) {
+      this.toast(`${file.name}: cannot load the snapshot: ${e.message || e}`);
+      return;
+    }
+    this.pause();
+    // The next restart sends its source again (the worker's is the snapshot now).
+    this.sentSource = null;
+    this.client.restore(text, file.name);
+    this.toast(`restored ${file.name}`, 'info');
+  }
+
   async loadFiles(files) {
     if (!files || files.length === 0) return;
+    const json = [...files].filter((f) => f.name.toLowerCase().endsWith('.json'));
+    if (json.length) {
+      if (files.length > 1) {
+        this.toast(`${json[0].name}: a snapshot is loaded alone, not together with other files`);
+        return;
+      }
+      return this.loadSnapshot(json[0]);
+    }
     let set;
     try {
       set = await readScanFiles(files);
@@ -387,6 +453,12 @@ class App {
   }
 
   #dropAndPick() {
+    const snap = $('snapshot-input');
+    snap.addEventListener('change', () => {
+      const f = snap.files[0];
+      snap.value = '';
+      if (f) this.loadSnapshot(f);
+    });
     const input = $('file-input');
     input.addEventListener('change', () => {
       const files = [...input.files];
@@ -477,8 +549,8 @@ class App {
       if (kind === 'json') {
         download(toJSON(polys, { source: $('source-label').textContent, scans: this.latest.index + 1, options: this.options }), `${stamp}.json`, 'application/json');
       } else if (kind === 'geojson') {
-        const origin = this.geo.enabled ? { lat: this.geo.lat, lon: this.geo.lon, alt: this.geo.alt } : null;
-        download(toGeoJSON(polys, origin), `${stamp}.geojson`, 'application/geo+json');
+        const frame = this.geo.enabled ? { origin: { lat: this.geo.lat, lon: this.geo.lon, alt: this.geo.alt }, heading: this.geo.heading } : null;
+        download(toGeoJSON(polys, frame), `${stamp}.geojson`, 'application/geo+json');
       } else if (kind === 'glb') {
         if (!this.latest.mesh) throw new Error('no mesh yet');
         download(await toGLB(this.latest.mesh, polys), `${stamp}.glb`, 'model/gltf-binary');

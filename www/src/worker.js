@@ -22,6 +22,9 @@
 //   { type: 'detect', request, points, options }
 //        One-shot detect(points, options) on a world-frame cloud, apart from
 //        the run (the run's scenario is untouched).
+//   { type: 'restore', run, json, label }  replace the run by Scenario.fromJSON(json)
+//        (json: a snapshot's text); answered by 'reset' (source kind
+//        'snapshot', total 0), 'restored' and 'state' (done), or by 'error'
 // worker -> page
 //   { type: 'ready', defaults }            wasm loaded; defaults: every option of
 //                                          each preset ({ gpp1, gpp2 }), for a GUI
@@ -44,6 +47,9 @@
 //   { type: 'result', request, polygons?, error?, ms }
 //        the request's answer: polygons (vertices transferred), or an error
 //        message
+//   { type: 'restored', run, scans, polygons, mesh, options }
+//        the restored scenario: scans it had seen, its polygons and mesh
+//        (typed arrays transferred), its options
 //   { type: 'error', run, message, fatal }  fatal: the module is unusable,
 //                                            start a new worker
 //
@@ -143,6 +149,8 @@ function configure({ run, options, source }) {
   } else if (src.kind === 'files') {
     st.total = src.scans.length;
     label = src.label;
+  } else if (src.kind === 'snapshot') {
+    throw new Error('a restored snapshot has no scans to replay: choose a scan source');
   } else {
     throw new Error(`unknown source kind '${src.kind}'`);
   }
@@ -155,6 +163,41 @@ function configure({ run, options, source }) {
 function owned(a) {
   if (a.byteOffset === 0 && a.buffer.byteLength === a.byteLength && !(typeof SharedArrayBuffer !== 'undefined' && a.buffer instanceof SharedArrayBuffer)) return a;
   return a.slice();
+}
+
+/** Polygons and mesh of the scenario, with their typed arrays to transfer. */
+function polygonsAndMesh(transfer) {
+  const polygons = st.scenario.polygons();
+  for (const p of polygons) {
+    p.vertices = owned(p.vertices);
+    transfer.push(p.vertices.buffer);
+  }
+  const mesh = st.scenario.mesh();
+  mesh.positions = owned(mesh.positions);
+  mesh.indices = owned(mesh.indices);
+  mesh.polygonIds = owned(mesh.polygonIds);
+  transfer.push(mesh.positions.buffer, mesh.indices.buffer, mesh.polygonIds.buffer);
+  return { polygons, mesh };
+}
+
+/** Replace the run by a scenario restored from a snapshot's JSON text. */
+function restore({ run, json, label }) {
+  clearTimer();
+  st.playing = false;
+  // Parsed before anything is replaced: a bad snapshot leaves the run as it was.
+  const scenario = Scenario.fromJSON(json);
+  freeAll();
+  st.run = run;
+  st.inFlight = 0;
+  st.cursor = 0;
+  st.total = 0;
+  st.scenario = scenario;
+  st.source = { kind: 'snapshot', label: label || 'snapshot' };
+  postMessage({ type: 'reset', run, source: { kind: 'snapshot', label: st.source.label, total: 0 } });
+  const transfer = [];
+  const { polygons, mesh } = polygonsAndMesh(transfer);
+  postMessage({ type: 'restored', run, scans: scenario.scans, polygons, mesh, options: scenario.options() }, transfer);
+  postMessage({ type: 'state', run, playing: false, done: true });
 }
 
 function stepOnce() {
@@ -179,18 +222,7 @@ function stepOnce() {
     index === 0 || report.added.length > 0 || report.grown.length > 0 || report.merged.length > 0;
   const transfer = [];
   let polygons, mesh;
-  if (changed) {
-    polygons = st.scenario.polygons();
-    for (const p of polygons) {
-      p.vertices = owned(p.vertices);
-      transfer.push(p.vertices.buffer);
-    }
-    mesh = st.scenario.mesh();
-    mesh.positions = owned(mesh.positions);
-    mesh.indices = owned(mesh.indices);
-    mesh.polygonIds = owned(mesh.polygonIds);
-    transfer.push(mesh.positions.buffer, mesh.indices.buffer, mesh.polygonIds.buffer);
-  }
+  if (changed) ({ polygons, mesh } = polygonsAndMesh(transfer));
   // Simulated scans are ours to give away; file scans stay here for replays.
   const shown = st.sim ? owned(points) : points.slice();
   transfer.push(shown.buffer, labels.buffer);
@@ -317,6 +349,9 @@ onmessage = async (ev) => {
         st.inFlight = Math.max(0, st.inFlight - 1);
         if (st.playing && st.timer === null) schedule(0);
         break;
+      case 'restore':
+        restore(m);
+        break;
       case 'snapshot':
         postMessage({ type: 'snapshot', request: m.request, json: st.scenario ? st.scenario.toJSONString() : null });
         break;
@@ -327,6 +362,6 @@ onmessage = async (ev) => {
         throw new Error(`unknown message type '${m.type}'`);
     }
   } catch (e) {
-    fail(e, m.type === 'configure' ? 'options' : m.type);
+    fail(e, m.type === 'configure' ? 'options' : m.type === 'restore' ? `snapshot ${m.label || ''}`.trim() : m.type);
   }
 };

@@ -3,10 +3,14 @@
 // modules), no caching (a rebuilt www/pkg is picked up on reload).
 //
 //   node www/tools/static-server.mjs [--port 8080] [--root www] [--host 127.0.0.1]
+//                                    [--mount /js/=js ...]
 //
 // or, from a script or test:
 //   import { startServer } from './www/tools/static-server.mjs';
 //   const server = await startServer({ root, port: 0 }); // server.url, server.close()
+//
+// A mount serves a folder outside the root under a URL prefix: the map page
+// imports the package's own JS modules (js/geo.mjs) as /js/geo.mjs.
 
 import { createServer } from 'node:http';
 import { createReadStream, promises as fs } from 'node:fs';
@@ -47,9 +51,16 @@ function mimeOf(file) {
  * `{ url, port, close() }` (close resolves when the server has stopped).
  * `port: 0` picks a free port.
  */
-export function startServer({ root, port = 8080, host = '127.0.0.1', quiet = true } = {}) {
+export function startServer({ root, port = 8080, host = '127.0.0.1', quiet = true, mounts = {} } = {}) {
   if (!LOOPBACK.has(host)) throw new Error(`refusing to bind ${host}: the demo server is loopback only`);
-  const base = path.resolve(root);
+  const rootDir = path.resolve(root);
+  // Longest prefix first; each prefix is '/name/'.
+  const mounted = Object.entries(mounts)
+    .map(([prefix, dir]) => {
+      if (!/^\/[^/]+(\/[^/]+)*\/$/.test(prefix)) throw new Error(`mount prefix '${prefix}' must look like /name/`);
+      return [prefix, path.resolve(dir)];
+    })
+    .sort((a, b) => b[0].length - a[0].length);
   const server = createServer(async (req, res) => {
     try {
       if (req.method !== 'GET' && req.method !== 'HEAD') {
@@ -58,7 +69,16 @@ export function startServer({ root, port = 8080, host = '127.0.0.1', quiet = tru
       }
       const url = new URL(req.url, 'http://localhost');
       let rel = decodeURIComponent(url.pathname);
-      let file = path.resolve(base, '.' + rel);
+      let base = rootDir;
+      let inBase = rel;
+      for (const [prefix, dir] of mounted) {
+        if (rel.startsWith(prefix)) {
+          base = dir;
+          inBase = rel.slice(prefix.length - 1);
+          break;
+        }
+      }
+      let file = path.resolve(base, '.' + inBase);
       if (file !== base && !file.startsWith(base + path.sep)) {
         res.writeHead(403).end('forbidden');
         return;
@@ -114,11 +134,21 @@ if (process.argv[1] && path.resolve(process.argv[1]) === fileURLToPath(import.me
   const root = opt('root', path.join(path.dirname(fileURLToPath(import.meta.url)), '..'));
   const port = Number(opt('port', '8080'));
   const host = opt('host', '127.0.0.1');
+  const mounts = {};
+  args.forEach((a, i) => {
+    if (a !== '--mount') return;
+    const [prefix, dir] = String(args[i + 1] ?? '').split('=');
+    if (!prefix || !dir) {
+      console.error(`serve: --mount wants /prefix/=folder, got '${args[i + 1] ?? ''}'`);
+      process.exit(2);
+    }
+    mounts[prefix] = dir;
+  });
   if (!Number.isInteger(port) || port < 0 || port > 65535) {
     console.error(`serve: bad port '${opt('port')}'`);
     process.exit(2);
   }
-  startServer({ root, port, host, quiet: !args.includes('--verbose') })
+  startServer({ root, port, host, mounts, quiet: !args.includes('--verbose') })
     .then((s) => {
       console.log(`polyscene demo: ${s.url}  (serving ${path.resolve(root)}; Ctrl-C to stop)`);
       const stop = () => s.close().then(() => process.exit(0));
