@@ -697,3 +697,18 @@ fn too_many_points_are_refused_before_anything_is_read() {
     assert!(e.to_string().contains("more than the 16777216"), "{e}");
     assert_eq!(s.scans(), 0);
 }
+
+#[test]
+fn an_expansion_gate_below_three_centimetres_is_taken_as_given() {
+    // expandAcross below the gate's 3 cm floor once made the gate's clamp panic.
+    let d = drive(Layout::Street, DVec3::ZERO);
+    let mut params = Params::gpp2();
+    params.other.expand_across = 1e-3;
+    params.ground.expand_across = 1e-3;
+    let mut s = Scenario::new(params).unwrap();
+    for k in 0..3 {
+        let scan = d.scan(k).unwrap();
+        s.add_scan(&scan.points, 4, &scan.pose).unwrap();
+    }
+    assert!(!s.primitives().is_empty());
+}

@@ -169,7 +169,7 @@ fn a_scenario_takes_scans_with_poses_and_refuses_bad_ones() {
     let m = message(JsScenario::from_json("{}".into()));
     assert!(m.contains("not a polyscene snapshot"), "{m}");
     // After free(): a clear message.
-    s.release();
+    s.release().unwrap();
     let m = message(s.polygons());
     assert!(m.contains("Scenario was freed"), "{m}");
 }

@@ -355,6 +355,7 @@ fn numbers_of<T: Number>(
     v: &JsValue,
     what: &str,
     max: usize,
+    check_len: impl Fn(usize) -> Result<()>,
 ) -> std::result::Result<Vec<T>, NumbersError> {
     let too_long = |len: f64| {
         Failure::new(format!(
@@ -368,6 +369,7 @@ fn numbers_of<T: Number>(
         if len > max {
             return Err(too_long(len as f64).into());
         }
+        check_len(len).map_err(Failure::from)?;
         let mut out = room::<T>(len, what)?;
         out.resize(len, T::default());
         T::copy(&mut out, v).map_err(|e| {
@@ -401,6 +403,7 @@ fn numbers_of<T: Number>(
         return Err(too_long(len).into());
     }
     let len = len as usize;
+    check_len(len).map_err(Failure::from)?;
     let mut out = room::<T>(len, what)?;
     for i in 0..len {
         let x = js::get_index(v, i as u32)
@@ -434,7 +437,12 @@ fn json_value(key: &str, v: &JsValue) -> WasmResult<Value> {
             .into()),
         };
     }
-    let nums = match numbers_of::<f64>(v, &format!("option '{key}'"), MAX_OPTION_NUMBERS) {
+    let nums = match numbers_of::<f64>(
+        v,
+        &format!("option '{key}'"),
+        MAX_OPTION_NUMBERS,
+        |_| Ok(()),
+    ) {
         Ok(nums) => nums,
         Err(NumbersError::Failed(f)) => return Err(f),
         Err(NumbersError::NotNumber(i, _)) => {
@@ -484,7 +492,15 @@ fn json_number(key: &str, x: f64) -> Result<Value> {
 /// to f32). More than [`MAX_POINTS`] points are refused before anything is
 /// allocated.
 pub(crate) fn points_of(v: &JsValue, stride: Stride) -> WasmResult<Vec<f32>> {
-    match numbers_of::<f32>(v, "points", MAX_POINTS.saturating_mul(stride)) {
+    // A length that is no multiple of the stride is refused before the copy.
+    let whole = |len: usize| {
+        if len % stride == 0 {
+            Ok(())
+        } else {
+            Err(Error::BadLength { len, stride })
+        }
+    };
+    match numbers_of::<f32>(v, "points", MAX_POINTS.saturating_mul(stride), whole) {
         Ok(values) => Ok(values),
         Err(NumbersError::Failed(f)) => Err(f),
         Err(NumbersError::NotNumber(i, x)) => Err(invalid(format!(
@@ -520,7 +536,7 @@ fn pose_of(v: &JsValue) -> WasmResult<DMat4> {
             raw = elements;
         }
     }
-    let nums = match numbers_of::<f64>(&raw, "option 'pose'", MAX_OPTION_NUMBERS) {
+    let nums = match numbers_of::<f64>(&raw, "option 'pose'", MAX_OPTION_NUMBERS, |_| Ok(())) {
         Ok(nums) => nums,
         Err(NumbersError::Failed(f)) => return Err(f),
         Err(NumbersError::NotNumber(i, _)) => {

@@ -47,6 +47,13 @@ function detached(Type, n) {
   return a;
 }
 
+/** Buffers one point beyond the limit at stride 3 and 4 (200 and 268 MB), made once. */
+const huges = new Map();
+function huge(stride) {
+  if (!huges.has(stride)) huges.set(stride, new Float32Array(stride * 2 ** 24 + stride));
+  return huges.get(stride);
+}
+
 function revoked() {
   const { proxy, revoke } = Proxy.revocable({}, {});
   revoke();
@@ -113,7 +120,7 @@ const hostileArray = fc.oneof(
   fc.constant(maker("Array(1e9)", () => new Array(1e9))),
   fc.constant(maker("Array length 2^32-1", () => { const a = []; a.length = 2 ** 32 - 1; return a; })),
   fc.constant(maker("Proxy(Array) length 1e12", () => new Proxy([], { get(t, k) { return k === "length" ? 1e12 : 0; } }))),
-  fc.constant(maker("Float32Array(2^24*3+3)", () => new Float32Array(3 * 2 ** 24 + 3))),
+  fc.constantFrom(3, 4).map((k) => maker(`Float32Array(2^24*${k}+${k})`, () => huge(k))),
   fc.constant(maker("Int32Array", () => new Int32Array(9))),
   fc.constant(maker("BigInt64Array", () => new BigInt64Array(3))),
   fc.constant(maker("DataView", () => new DataView(new ArrayBuffer(12)))),
