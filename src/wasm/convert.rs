@@ -355,39 +355,66 @@ fn numbers_of<T: Number>(
     v: &JsValue,
     what: &str,
     max: usize,
-    check_len: impl Fn(usize) -> Result<()>,
+    check_len: &dyn Fn(usize) -> Result<()>,
 ) -> std::result::Result<Vec<T>, NumbersError> {
-    let too_long = |len: f64| {
-        Failure::new(format!(
-            "{what}: {len} numbers is more than the {max} it may hold"
-        ))
+    let Some((tag, len)) = js::typed_array(v) else {
+        // The slow path, shared by both element types.
+        return Ok(array_numbers(v, what, max, check_len)?
+            .into_iter()
+            .map(T::of_f64)
+            .collect());
     };
-    if let Some((tag, len)) = js::typed_array(v) {
-        if tag != "Float32Array" && tag != "Float64Array" {
-            return Err(NumbersError::NotArray);
-        }
-        if len > max {
-            return Err(too_long(len as f64).into());
-        }
-        check_len(len).map_err(Failure::from)?;
-        let mut out = room::<T>(len, what)?;
-        out.resize(len, T::default());
-        T::copy(&mut out, v).map_err(|e| {
-            // Only a detached buffer makes an empty view's copy throw.
-            if len == 0 {
-                Failure::caused(
-                    format!(
-                        "{what}: the {tag}'s buffer is detached (it was transferred, e.g. by \
-                         postMessage) and can no longer be read"
-                    ),
-                    e,
-                )
-            } else {
-                Failure::thrown(&format!("reading {what} (a {tag})"), e)
-            }
-        })?;
-        return Ok(out);
+    if tag != "Float32Array" && tag != "Float64Array" {
+        return Err(NumbersError::NotArray);
     }
+    let len = checked_len(len as f64, what, max, check_len)?;
+    let mut out = room::<T>(len, what)?;
+    out.resize(len, T::default());
+    T::copy(&mut out, v).map_err(|e| {
+        // Only a detached buffer makes an empty view's copy throw.
+        if len == 0 {
+            Failure::caused(
+                format!(
+                    "{what}: the {tag}'s buffer is detached (it was transferred, e.g. by \
+                     postMessage) and can no longer be read"
+                ),
+                e,
+            )
+        } else {
+            Failure::thrown(&format!("reading {what} (a {tag})"), e)
+        }
+    })?;
+    Ok(out)
+}
+
+/// A length within `max` and accepted by `check_len`.
+fn checked_len(
+    len: f64,
+    what: &str,
+    max: usize,
+    check_len: &dyn Fn(usize) -> Result<()>,
+) -> WasmResult<usize> {
+    if !(len >= 0.0 && len.fract() == 0.0) {
+        return Err(Failure::new(format!(
+            "{what}: its length is not a whole number"
+        )));
+    }
+    if len > max as f64 {
+        return Err(Failure::new(format!(
+            "{what}: {len} numbers is more than the {max} it may hold"
+        )));
+    }
+    check_len(len as usize)?;
+    Ok(len as usize)
+}
+
+/// The numbers of an `Array` (or a Proxy around one), element by element.
+fn array_numbers(
+    v: &JsValue,
+    what: &str,
+    max: usize,
+    check_len: &dyn Fn(usize) -> Result<()>,
+) -> std::result::Result<Vec<f64>, NumbersError> {
     let array = js::is_array(v).map_err(|e| Failure::thrown(&format!("reading {what}"), e))?;
     if !array {
         return Err(NumbersError::NotArray);
@@ -396,20 +423,13 @@ fn numbers_of<T: Number>(
         .map_err(|e| Failure::thrown(&format!("reading {what}.length"), e))?
         .as_f64()
         .unwrap_or(f64::NAN);
-    if !(len >= 0.0 && len.fract() == 0.0) {
-        return Err(Failure::new(format!("{what}: its length is not a whole number")).into());
-    }
-    if len > max as f64 {
-        return Err(too_long(len).into());
-    }
-    let len = len as usize;
-    check_len(len).map_err(Failure::from)?;
-    let mut out = room::<T>(len, what)?;
+    let len = checked_len(len, what, max, check_len)?;
+    let mut out = room::<f64>(len, what)?;
     for i in 0..len {
         let x = js::get_index(v, i as u32)
             .map_err(|e| Failure::thrown(&format!("reading {what}[{i}]"), e))?;
         match x.as_f64() {
-            Some(x) => out.push(T::of_f64(x)),
+            Some(x) => out.push(x),
             None => return Err(NumbersError::NotNumber(i, x)),
         }
     }
@@ -437,12 +457,9 @@ fn json_value(key: &str, v: &JsValue) -> WasmResult<Value> {
             .into()),
         };
     }
-    let nums = match numbers_of::<f64>(
-        v,
-        &format!("option '{key}'"),
-        MAX_OPTION_NUMBERS,
-        |_| Ok(()),
-    ) {
+    let nums = match numbers_of::<f64>(v, &format!("option '{key}'"), MAX_OPTION_NUMBERS, &|_| {
+        Ok(())
+    }) {
         Ok(nums) => nums,
         Err(NumbersError::Failed(f)) => return Err(f),
         Err(NumbersError::NotNumber(i, _)) => {
@@ -500,7 +517,7 @@ pub(crate) fn points_of(v: &JsValue, stride: Stride) -> WasmResult<Vec<f32>> {
             Err(Error::BadLength { len, stride })
         }
     };
-    match numbers_of::<f32>(v, "points", MAX_POINTS.saturating_mul(stride), whole) {
+    match numbers_of::<f32>(v, "points", MAX_POINTS.saturating_mul(stride), &whole) {
         Ok(values) => Ok(values),
         Err(NumbersError::Failed(f)) => Err(f),
         Err(NumbersError::NotNumber(i, x)) => Err(invalid(format!(
@@ -536,7 +553,7 @@ fn pose_of(v: &JsValue) -> WasmResult<DMat4> {
             raw = elements;
         }
     }
-    let nums = match numbers_of::<f64>(&raw, "option 'pose'", MAX_OPTION_NUMBERS, |_| Ok(())) {
+    let nums = match numbers_of::<f64>(&raw, "option 'pose'", MAX_OPTION_NUMBERS, &|_| Ok(())) {
         Ok(nums) => nums,
         Err(NumbersError::Failed(f)) => return Err(f),
         Err(NumbersError::NotNumber(i, _)) => {
