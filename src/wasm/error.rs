@@ -13,7 +13,7 @@
 
 use super::js::summary;
 use crate::error::Error;
-use js_sys::Object;
+use js_sys::{Object, Reflect};
 use wasm_bindgen::JsValue;
 
 /// What every fallible export returns: the error becomes a thrown JS `Error`.
@@ -80,7 +80,8 @@ impl From<Failure> for JsValue {
                 // `new Error(message, { cause })`: `cause` an own,
                 // non-enumerable property, as JS code makes it.
                 let options = Object::new();
-                super::convert::set(&options, "cause", cause);
+                // Setting a property of a fresh plain object cannot fail.
+                let _ = Reflect::set(&options, &"cause".into(), &cause);
                 js_sys::Error::new_with_options(&f.message, &options).into()
             }
         }
