@@ -10,10 +10,11 @@ use glam::{DMat4, DVec3, Vec3};
 pub const MAX_COORDINATE: f64 = 1e9;
 
 /// Most points one cloud (a scan, or a cloud given to detection) may hold:
-/// 2^24 = 16,777,216. Processing takes about 110 bytes a point at its
-/// peak, so a cloud at the limit fits in the 4 GiB of a wasm instance with
-/// room for the map; beyond it the input is refused before anything is
-/// allocated, rather than running out of memory part-way.
+/// 2^24 = 16,777,216. Processing takes about 100 bytes a point at its
+/// peak (a scan at the limit: 1.84 GB resident in Node, the input
+/// included), so a cloud at the limit fits in the 4 GiB of a wasm instance
+/// with room for the map; beyond it the input is refused before anything
+/// is allocated, rather than running out of memory part-way.
 pub const MAX_POINTS: usize = 1 << 24;
 
 /// [`Error::TooManyPoints`] when `points` exceeds [`MAX_POINTS`].
