@@ -73,6 +73,8 @@ impl<E: std::error::Error> From<E> for Failure {
 }
 
 impl From<Failure> for JsValue {
+    // One copy for all exports (inlined, it grew every export's shim).
+    #[inline(never)]
     fn from(f: Failure) -> JsValue {
         match f.cause {
             None => js_sys::Error::new(&f.message).into(),

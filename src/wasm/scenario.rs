@@ -8,7 +8,7 @@ use super::js::{self, describe};
 use crate::mesh;
 use crate::scenario::{Scenario, MAX_SNAPSHOT_BYTES};
 use js_sys::{Array, JsString, Object, Uint32Array};
-use std::cell::RefCell;
+use std::cell::{Ref, RefCell, RefMut};
 use wasm_bindgen::prelude::*;
 use wasm_bindgen::JsCast;
 
@@ -41,23 +41,29 @@ impl JsScenario {
         }
     }
 
-    /// `f` on the scenario, or an `Error` when it was freed.
-    fn with<T>(&self, f: impl FnOnce(&Scenario) -> WasmResult<T>) -> WasmResult<T> {
-        let inner = self
-            .inner
-            .try_borrow()
-            .map_err(|_| invalid(BUSY_SCENARIO))?;
-        f(inner.as_ref().ok_or_else(|| invalid(FREED_SCENARIO))?)
+    /// The scenario, or an `Error` when it was freed or is busy.
+    fn get(&self) -> WasmResult<Ref<'_, Scenario>> {
+        let inner = self.inner.try_borrow().map_err(|_| busy())?;
+        Ref::filter_map(inner, Option::as_ref).map_err(|_| freed())
     }
 
-    /// `f` on the scenario, mutable.
-    fn with_mut<T>(&self, f: impl FnOnce(&mut Scenario) -> WasmResult<T>) -> WasmResult<T> {
-        let mut inner = self
-            .inner
-            .try_borrow_mut()
-            .map_err(|_| invalid(BUSY_SCENARIO))?;
-        f(inner.as_mut().ok_or_else(|| invalid(FREED_SCENARIO))?)
+    /// The scenario, mutable.
+    fn get_mut(&self) -> WasmResult<RefMut<'_, Scenario>> {
+        let inner = self.inner.try_borrow_mut().map_err(|_| busy())?;
+        RefMut::filter_map(inner, Option::as_mut).map_err(|_| freed())
     }
+}
+
+#[cold]
+#[inline(never)]
+fn freed() -> Failure {
+    Failure::new(FREED_SCENARIO)
+}
+
+#[cold]
+#[inline(never)]
+fn busy() -> Failure {
+    Failure::new(BUSY_SCENARIO)
 }
 
 #[wasm_bindgen(js_class = Scenario)]
@@ -94,22 +100,23 @@ impl JsScenario {
     ) -> WasmResult<JsValue> {
         let options = ScanOptions::from_js(&options.unwrap_or(JsValue::UNDEFINED))?;
         let values = points_of(&points, options.stride)?;
-        let report =
-            self.with_mut(|s| Ok(s.add_scan(&values, options.stride, &options.pose)?))?;
+        let report = self
+            .get_mut()?
+            .add_scan(&values, options.stride, &options.pose)?;
         to_js(&report)
     }
 
     /// The polygons, sorted by id: plain objects owned by JS (see `Polygon`).
     #[wasm_bindgen(unchecked_return_type = "Polygon[]")]
     pub fn polygons(&self) -> WasmResult<Array> {
-        self.with(|s| Ok(polygons_array(s.primitives())))
+        Ok(polygons_array(self.get()?.primitives()))
     }
 
     /// Per point of the last scan: the id of the polygon that explained it,
     /// or `0xFFFFFFFF` when none did (empty before the first scan).
     #[wasm_bindgen(js_name = lastLabels)]
     pub fn last_labels(&self) -> WasmResult<Uint32Array> {
-        self.with(|s| Ok(Uint32Array::from(s.last_labels())))
+        Ok(Uint32Array::from(self.get()?.last_labels()))
     }
 
     /// The polygons triangulated for WebGL (constrained Delaunay inside
@@ -118,26 +125,26 @@ impl JsScenario {
     /// triangle. Outlines that cannot be triangulated are left out.
     #[wasm_bindgen(unchecked_return_type = "Mesh")]
     pub fn mesh(&self) -> WasmResult<Object> {
-        self.with(|s| Ok(mesh_object(&mesh::triangulate(s.primitives()))))
+        Ok(mesh_object(&mesh::triangulate(self.get()?.primitives())))
     }
 
     /// Scans added so far.
     #[wasm_bindgen(getter)]
     pub fn scans(&self) -> WasmResult<f64> {
-        self.with(|s| Ok(s.scans() as f64))
+        Ok(self.get()?.scans() as f64)
     }
 
     /// Number of polygons.
     #[wasm_bindgen(getter, js_name = polygonCount)]
     pub fn polygon_count(&self) -> WasmResult<u32> {
-        self.with(|s| Ok(s.primitives().len() as u32))
+        Ok(self.get()?.primitives().len() as u32)
     }
 
     /// The parameters in effect, every key (`PipelineOptions` without
     /// `preset`).
     #[wasm_bindgen(unchecked_return_type = "Required<Omit<PipelineOptions, \"preset\">>")]
     pub fn options(&self) -> WasmResult<JsValue> {
-        self.with(|s| to_js(s.params()))
+        to_js(self.get()?.params())
     }
 
     /// The whole state as a plain JSON-safe object (parameters included):
@@ -145,7 +152,8 @@ impl JsScenario {
     /// exactly as if never stopped. Called by `JSON.stringify(scenario)`.
     #[wasm_bindgen(js_name = toJSON, unchecked_return_type = "ScenarioSnapshot")]
     pub fn to_json(&self) -> WasmResult<JsValue> {
-        let text = self.with(|scenario| {
+        let text = {
+            let scenario = self.get()?;
             let p = scenario.params();
             for (key, v) in [("seed", p.seed), ("maxWork", p.max_work)] {
                 if v as f64 > MAX_SAFE_INTEGER {
@@ -156,8 +164,8 @@ impl JsScenario {
                     .into());
                 }
             }
-            Ok(scenario.to_json())
-        })?;
+            scenario.to_json()
+        };
         js_sys::JSON::parse(&text)
             .map_err(|_| Failure::new("snapshot: the state could not be serialised"))
     }
@@ -165,7 +173,7 @@ impl JsScenario {
     /// The snapshot as a JSON string (exact for every value).
     #[wasm_bindgen(js_name = toJSONString)]
     pub fn to_json_string(&self) -> WasmResult<String> {
-        self.with(|s| Ok(s.to_json()))
+        Ok(self.get()?.to_json())
     }
 
     /// Restore a scenario from `toJSON()` output (an object, e.g. after
@@ -214,10 +222,7 @@ impl JsScenario {
     /// `Error` saying it was freed; calling `free()` again does nothing.
     #[wasm_bindgen(js_name = free)]
     pub fn release(&self) -> WasmResult<()> {
-        *self
-            .inner
-            .try_borrow_mut()
-            .map_err(|_| invalid(BUSY_SCENARIO))? = None;
+        *self.inner.try_borrow_mut().map_err(|_| busy())? = None;
         Ok(())
     }
 }
