@@ -9,6 +9,25 @@ use glam::{DMat4, DVec3, Vec3};
 /// area and grid index stays finite and exact enough.
 pub const MAX_COORDINATE: f64 = 1e9;
 
+/// Most points one cloud (a scan, or a cloud given to detection) may hold:
+/// 2^24 = 16,777,216. Processing takes about 100 bytes a point at its
+/// peak (a scan at the limit: 1.84 GB resident in Node, the input
+/// included), so a cloud at the limit fits in the 4 GiB of a wasm instance
+/// with room for the map; beyond it the input is refused before anything
+/// is allocated, rather than running out of memory part-way.
+pub const MAX_POINTS: usize = 1 << 24;
+
+/// [`Error::TooManyPoints`] when `points` exceeds [`MAX_POINTS`].
+pub fn check_count(points: usize) -> Result<()> {
+    if points > MAX_POINTS {
+        return Err(Error::TooManyPoints {
+            points,
+            limit: MAX_POINTS,
+        });
+    }
+    Ok(())
+}
+
 /// The first point whose world coordinates lie beyond [`MAX_COORDINATE`].
 fn check_range(points: impl Iterator<Item = DVec3>) -> Result<()> {
     for (i, p) in points.enumerate() {
@@ -34,6 +53,7 @@ pub fn check_finite(values: &[f32], stride: usize) -> Result<f32> {
             stride,
         });
     }
+    check_count(values.len() / stride)?;
     largest_coordinate(values, stride)
 }
 
@@ -97,6 +117,7 @@ impl Cloud {
     /// box rounded to whole metres, so translated copies of a cloud get the
     /// same local coordinates.
     pub fn from_world_f64(points: &[DVec3]) -> Result<Self> {
+        check_count(points.len())?;
         if let Some(i) = points.iter().position(|p| !p.is_finite()) {
             return Err(Error::NonFinite { point: i });
         }

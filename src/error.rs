@@ -29,6 +29,13 @@ pub enum Error {
         /// The limit (m).
         limit: f64,
     },
+    /// More points in one cloud than [`MAX_POINTS`](crate::cloud::MAX_POINTS).
+    TooManyPoints {
+        /// Points given.
+        points: usize,
+        /// The limit.
+        limit: usize,
+    },
     /// A pose that is not a rigid transform, or of the wrong size.
     BadPose(String),
     /// An option out of range or unknown.
@@ -64,6 +71,11 @@ impl fmt::Display for Error {
                 f,
                 "point {point} lies more than {limit:e} m from the world origin (after the \
                  pose, for a scan); coordinates are metres"
+            ),
+            Error::TooManyPoints { points, limit } => write!(
+                f,
+                "{points} points is more than the {limit} one cloud may hold \
+                 (the memory of a wasm instance is 4 GiB); split the cloud"
             ),
             Error::BadPose(why) => write!(f, "invalid pose: {why}"),
             Error::BadOption { key, reason } => write!(f, "option '{key}': {reason}"),

@@ -6,7 +6,7 @@
 
 use js_sys::{Array, Float32Array, Float64Array, Reflect, Uint32Array, JSON};
 use polyscene::params::Params;
-use polyscene::wasm::{default_options, detect, simulate, JsScenario};
+use polyscene::wasm::{default_options, detect, simulate, Failure, JsScenario};
 use wasm_bindgen::prelude::*;
 use wasm_bindgen::JsCast;
 use wasm_bindgen_test::wasm_bindgen_test;
@@ -19,8 +19,8 @@ fn get(v: &JsValue, key: &str) -> JsValue {
     Reflect::get(v, &key.into()).expect("property")
 }
 
-/// The message of the `Error` a `JsError` becomes in JS.
-fn message<T>(r: Result<T, JsError>) -> String {
+/// The message of the `Error` a `Failure` becomes in JS.
+fn message<T>(r: Result<T, Failure>) -> String {
     match r {
         Ok(_) => panic!("expected an error"),
         Err(e) => {
@@ -58,7 +58,7 @@ fn options_merge_over_the_preset() {
     );
     // No options at all: gpp2.
     let d = JsScenario::new(None).unwrap().options().unwrap();
-    let want = default_options(None).unwrap();
+    let want = default_options(JsValue::UNDEFINED).unwrap();
     assert_eq!(
         JSON::stringify(&d).unwrap().as_string(),
         JSON::stringify(&want).unwrap().as_string()
@@ -128,7 +128,7 @@ fn a_small_detection() {
 
 #[wasm_bindgen_test]
 fn a_scenario_takes_scans_with_poses_and_refuses_bad_ones() {
-    let mut s = JsScenario::new(None).unwrap();
+    let s = JsScenario::new(None).unwrap();
     // The floor seen from 1.8 m above its centre: the pose moves the sensor
     // frame to the world.
     let pose = json("[1,0,0,0, 0,1,0,0, 0,0,1,0, 5,5,1.8,1]");
@@ -169,7 +169,7 @@ fn a_scenario_takes_scans_with_poses_and_refuses_bad_ones() {
     let m = message(JsScenario::from_json("{}".into()));
     assert!(m.contains("not a polyscene snapshot"), "{m}");
     // After free(): a clear message.
-    s.release();
+    s.release().unwrap();
     let m = message(s.polygons());
     assert!(m.contains("Scenario was freed"), "{m}");
 }
@@ -190,7 +190,7 @@ fn the_simulator_runs() {
     assert_eq!(sim.cursor().unwrap(), 1);
     let m = message(simulate(Some(json(r#"{"layout": "forest"}"#))));
     assert!(m.contains("option 'layout'"), "{m}");
-    let m = message(sim.scan(n as f64));
+    let m = message(sim.scan(JsValue::from(n as f64)));
     assert!(m.contains("out of range"), "{m}");
 }
 

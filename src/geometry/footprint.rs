@@ -186,6 +186,17 @@ impl Footprint {
         self.cell
     }
 
+    /// The grid's lower and upper corners in frame coordinates (m); `None`
+    /// for an empty grid.
+    pub fn extent(&self) -> Option<(DVec2, DVec2)> {
+        if self.w == 0 || self.h == 0 {
+            return None;
+        }
+        let lo = DVec2::new(self.x0 as f64, self.y0 as f64) * self.cell;
+        let size = DVec2::new(self.w as f64, self.h as f64) * self.cell;
+        Some((lo, lo + size))
+    }
+
     #[inline]
     fn index_of(&self, p: DVec2) -> (i64, i64) {
         cell_index(p, 1.0 / self.cell)

@@ -7,6 +7,7 @@
 
 mod expand;
 mod index;
+pub mod snapshot;
 pub use crate::merge::MergeEvent;
 
 use crate::clock;
@@ -19,6 +20,11 @@ use crate::rng::Rng;
 use glam::{DMat4, DVec3};
 use index::ScanIndex;
 use serde::{Deserialize, Serialize};
+
+/// Longest snapshot text [`Scenario::from_json`] reads (bytes; 256 MiB):
+/// restoring one takes a few times its size in memory, which must fit in
+/// the 4 GiB of a wasm instance.
+pub const MAX_SNAPSHOT_BYTES: usize = 1 << 28;
 
 /// Voxel side of the per-scan index (m).
 const INDEX_VOXEL: f64 = 1.0;
@@ -225,11 +231,23 @@ impl Scenario {
         serde_json::to_string(self).unwrap_or_default()
     }
 
-    /// Restore from [`Scenario::to_json`] output.
+    /// Restore from [`Scenario::to_json`] output. The text is refused
+    /// (with a message) unless it is at most [`MAX_SNAPSHOT_BYTES`] long and
+    /// describes a state the pipeline could have reached; see
+    /// [`snapshot::check`] for what is checked.
     pub fn from_json(text: &str) -> Result<Self> {
+        if text.len() > MAX_SNAPSHOT_BYTES {
+            return Err(Error::Invalid(format!(
+                "not a polyscene snapshot: its text has {} bytes, more than the \
+                 {MAX_SNAPSHOT_BYTES} a snapshot may have",
+                text.len()
+            )));
+        }
         let s: Scenario = serde_json::from_str(text)
             .map_err(|e| Error::Invalid(format!("not a polyscene snapshot: {e}")))?;
         s.params.validate()?;
+        snapshot::check(&s.primitives, s.next_id, s.scans, &s.params)
+            .map_err(|e| Error::Invalid(format!("not a polyscene snapshot: {e}")))?;
         Ok(s)
     }
 }

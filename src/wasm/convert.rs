@@ -9,11 +9,15 @@
 //! generates the `.d.ts` interfaces from them (doc comments included), so
 //! their doc comments are the TypeScript documentation.
 //!
-//! Nothing here calls a JS function that can throw (a JS exception unwinding
-//! through wasm would leave a `&mut self` borrowed).
+//! Every read of a caller's value goes through [`super::js`], whose calls
+//! cannot let a JS exception through a Rust frame; what JS code throws
+//! becomes a [`Failure`] naming what was read, with the thrown value as
+//! `cause`.
 
-use super::error::{bad_option, invalid, WasmResult};
+use super::error::{bad_option, invalid, Failure, WasmResult};
+use super::js::{self, describe};
 use crate::cloud::check_rigid;
+use crate::cloud::MAX_POINTS;
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::params::Params;
@@ -23,7 +27,6 @@ use glam::{DMat4, DVec3};
 use js_sys::{Array, ArrayBuffer, Float32Array, Float64Array, Object, Reflect, Uint32Array, JSON};
 use serde_json::{Map, Value};
 use wasm_bindgen::prelude::*;
-use wasm_bindgen::JsCast;
 
 /// Largest integer a JS number holds exactly (2^53 - 1).
 pub(crate) const MAX_SAFE_INTEGER: f64 = 9_007_199_254_740_991.0;
@@ -96,12 +99,21 @@ struct Read {
     pose: Pose,
 }
 
+/// Longest key or string value of an options object (UTF-16 units): the
+/// longest valid one has a few dozen.
+const MAX_OPTION_CHARS: u32 = 256;
+
+/// Most numbers in an array option value (a pose has 16).
+const MAX_OPTION_NUMBERS: usize = 64;
+
 /// The one reader of option objects. `undefined` and `null` are no options;
 /// anything but a plain object is refused. Keys are read in the object's
 /// order (own enumerable keys; a key whose value is `undefined` is not
 /// given), and the first bad one is reported: a key the call does not take,
-/// a value JSON cannot hold, a bad `stride` or `pose`.
-fn read_options(v: &JsValue, keys: &Keys) -> Result<Read> {
+/// a value JSON cannot hold, a bad `stride` or `pose`. Whatever the object's
+/// getters or Proxy traps throw becomes an `Error` naming the key, with the
+/// thrown value as `cause`.
+fn read_options(v: &JsValue, keys: &Keys) -> WasmResult<Read> {
     let mut read = Read {
         map: Map::new(),
         stride: 3,
@@ -110,23 +122,32 @@ fn read_options(v: &JsValue, keys: &Keys) -> Result<Read> {
     if v.is_undefined() || v.is_null() {
         return Ok(read);
     }
-    if !v.is_object() || Array::is_array(v) || ArrayBuffer::is_view(v) {
+    let what = keys.what;
+    let array = js::is_array(v).map_err(|e| Failure::thrown(&format!("reading {what}"), e))?;
+    if !v.is_object() || array || ArrayBuffer::is_view(v) {
         return Err(invalid(format!(
-            "{} must be an object of options, got {}",
-            keys.what,
+            "{what} must be an object of options, got {}",
             describe(v)
-        )));
+        ))
+        .into());
     }
-    let obj: &Object = v.unchecked_ref();
-    for key in Object::keys(obj).iter() {
-        let value = Reflect::get(obj, &key).unwrap_or(JsValue::UNDEFINED);
+    let names =
+        js::keys(v).map_err(|e| Failure::thrown(&format!("listing the keys of {what}"), e))?;
+    for name in names {
+        let Some(key) = js::short_string(&name, MAX_OPTION_CHARS) else {
+            return Err(invalid(format!(
+                "{what}: a key longer than {MAX_OPTION_CHARS} characters is no option"
+            ))
+            .into());
+        };
+        let value = js::get_key(v, &name)
+            .map_err(|e| Failure::thrown(&format!("reading {what}.{key}"), e))?;
         if value.is_undefined() {
             continue;
         }
-        let key = key.as_string().unwrap_or_default();
         let own = keys.own.contains(&key.as_str());
         if let (false, Some(reason)) = (own, keys.closed) {
-            return Err(bad_option(&key, reason));
+            return Err(bad_option(&key, reason).into());
         }
         if own && key == "pose" {
             read.pose = pose_of(&value)?;
@@ -140,7 +161,8 @@ fn read_options(v: &JsValue, keys: &Keys) -> Result<Read> {
                     return Err(bad_option(
                         "stride",
                         format!("must be 3 (x, y, z) or 4 (x, y, z, intensity), got {json}"),
-                    ))
+                    )
+                    .into())
                 }
             };
             continue;
@@ -154,7 +176,7 @@ fn read_options(v: &JsValue, keys: &Keys) -> Result<Read> {
 
 impl ScenarioOptions {
     /// Read `new Scenario(options)`'s options.
-    pub(crate) fn from_js(v: &JsValue) -> Result<Self> {
+    pub(crate) fn from_js(v: &JsValue) -> WasmResult<Self> {
         let read = read_options(
             v,
             &Keys {
@@ -171,7 +193,7 @@ impl ScenarioOptions {
 
 impl DetectOptions {
     /// Read `detect(points, options)`'s options.
-    pub(crate) fn from_js(v: &JsValue) -> Result<Self> {
+    pub(crate) fn from_js(v: &JsValue) -> WasmResult<Self> {
         let read = read_options(
             v,
             &Keys {
@@ -189,7 +211,7 @@ impl DetectOptions {
 
 impl ScanOptions {
     /// Read `scenario.addScan(points, options)`'s options.
-    pub(crate) fn from_js(v: &JsValue) -> Result<Self> {
+    pub(crate) fn from_js(v: &JsValue) -> WasmResult<Self> {
         let read = read_options(
             v,
             &Keys {
@@ -207,7 +229,7 @@ impl ScanOptions {
 
 impl SimulateOptions {
     /// Read `simulate(options)`'s options.
-    pub(crate) fn from_js(v: &JsValue) -> Result<Self> {
+    pub(crate) fn from_js(v: &JsValue) -> WasmResult<Self> {
         let mut map = read_options(
             v,
             &Keys {
@@ -224,7 +246,8 @@ impl SimulateOptions {
                 return Err(bad_option(
                     "layout",
                     format!("expected 'street' or 'crossing', got {other}"),
-                ))
+                )
+                .into())
             }
         };
         let seed = match map.remove("seed") {
@@ -269,26 +292,152 @@ impl SimulateOptions {
 // ---------------------------------------------------------------------------
 // Values in.
 
-/// The numbers of an array-like: `Float32Array` and `Float64Array` (copied
-/// in one go) or an `Array` of numbers. `None` for anything else;
-/// `Some(Err(i))` when element `i` of an `Array` is not a number.
-fn numbers_of(v: &JsValue) -> Option<std::result::Result<Vec<f64>, usize>> {
-    if let Some(a) = v.dyn_ref::<Float64Array>() {
-        return Some(Ok(a.to_vec()));
+/// An element type the binding reads numbers into.
+trait Number: Copy + Default {
+    fn of_f64(x: f64) -> Self;
+    /// Copy a real `Float32Array` or `Float64Array` of `dst.len()`
+    /// elements into `dst`.
+    fn copy(dst: &mut [Self], src: &JsValue) -> std::result::Result<(), js::Thrown>;
+}
+
+impl Number for f32 {
+    fn of_f64(x: f64) -> f32 {
+        x as f32
     }
-    if let Some(a) = v.dyn_ref::<Float32Array>() {
-        return Some(Ok(a.to_vec().into_iter().map(f64::from).collect()));
+    fn copy(dst: &mut [f32], src: &JsValue) -> std::result::Result<(), js::Thrown> {
+        js::copy_f32(dst, src)
     }
-    let a = v.dyn_ref::<Array>()?;
-    Some(
-        (0..a.length())
-            .map(|i| a.get(i).as_f64().ok_or(i as usize))
-            .collect(),
-    )
+}
+
+impl Number for f64 {
+    fn of_f64(x: f64) -> f64 {
+        x
+    }
+    fn copy(dst: &mut [f64], src: &JsValue) -> std::result::Result<(), js::Thrown> {
+        js::copy_f64(dst, src)
+    }
+}
+
+/// Why reading an array-like failed before its elements were judged.
+enum NumbersError {
+    /// Not a `Float32Array`, `Float64Array` or `Array`.
+    NotArray,
+    /// Element `i` of an `Array` is this value, not a number.
+    NotNumber(usize, JsValue),
+    /// Anything else (too long, a throw, no memory): the final error.
+    Failed(Failure),
+}
+
+impl From<Failure> for NumbersError {
+    fn from(f: Failure) -> Self {
+        NumbersError::Failed(f)
+    }
+}
+
+/// An empty vector with room for `len` numbers, or an `Error` when wasm
+/// memory cannot grow that far.
+fn room<T>(len: usize, what: &str) -> WasmResult<Vec<T>> {
+    let mut out = Vec::new();
+    out.try_reserve_exact(len).map_err(|_| {
+        Failure::new(format!(
+            "{what}: {len} numbers do not fit in the memory left to this wasm instance"
+        ))
+    })?;
+    Ok(out)
+}
+
+/// The numbers of a `Float32Array` or `Float64Array` (copied in one go) or
+/// of an `Array` of numbers, at most `max` of them (checked before anything
+/// is allocated). `what` names the value in messages ("points", "option
+/// 'pose'"). A Proxy, a look-alike object or another typed array is
+/// [`NumbersError::NotArray`].
+fn numbers_of<T: Number>(
+    v: &JsValue,
+    what: &str,
+    max: usize,
+    check_len: &dyn Fn(usize) -> Result<()>,
+) -> std::result::Result<Vec<T>, NumbersError> {
+    let Some((tag, len)) = js::typed_array(v) else {
+        // The slow path, shared by both element types.
+        return Ok(array_numbers(v, what, max, check_len)?
+            .into_iter()
+            .map(T::of_f64)
+            .collect());
+    };
+    if tag != "Float32Array" && tag != "Float64Array" {
+        return Err(NumbersError::NotArray);
+    }
+    let len = checked_len(len as f64, what, max, check_len)?;
+    let mut out = room::<T>(len, what)?;
+    out.resize(len, T::default());
+    T::copy(&mut out, v).map_err(|e| {
+        // Only a detached buffer makes an empty view's copy throw.
+        if len == 0 {
+            Failure::caused(
+                format!(
+                    "{what}: the {tag}'s buffer is detached (it was transferred, e.g. by \
+                     postMessage) and can no longer be read"
+                ),
+                e,
+            )
+        } else {
+            Failure::thrown(&format!("reading {what} (a {tag})"), e)
+        }
+    })?;
+    Ok(out)
+}
+
+/// A length within `max` and accepted by `check_len`.
+fn checked_len(
+    len: f64,
+    what: &str,
+    max: usize,
+    check_len: &dyn Fn(usize) -> Result<()>,
+) -> WasmResult<usize> {
+    if !(len >= 0.0 && len.fract() == 0.0) {
+        return Err(Failure::new(format!(
+            "{what}: its length is not a whole number"
+        )));
+    }
+    if len > max as f64 {
+        return Err(Failure::new(format!(
+            "{what}: {len} numbers is more than the {max} it may hold"
+        )));
+    }
+    check_len(len as usize)?;
+    Ok(len as usize)
+}
+
+/// The numbers of an `Array` (or a Proxy around one), element by element.
+fn array_numbers(
+    v: &JsValue,
+    what: &str,
+    max: usize,
+    check_len: &dyn Fn(usize) -> Result<()>,
+) -> std::result::Result<Vec<f64>, NumbersError> {
+    let array = js::is_array(v).map_err(|e| Failure::thrown(&format!("reading {what}"), e))?;
+    if !array {
+        return Err(NumbersError::NotArray);
+    }
+    let len = js::get(v, "length")
+        .map_err(|e| Failure::thrown(&format!("reading {what}.length"), e))?
+        .as_f64()
+        .unwrap_or(f64::NAN);
+    let len = checked_len(len, what, max, check_len)?;
+    let mut out = room::<f64>(len, what)?;
+    for i in 0..len {
+        let x = js::get_index(v, i as u32)
+            .map_err(|e| Failure::thrown(&format!("reading {what}[{i}]"), e))?;
+        match x.as_f64() {
+            Some(x) => out.push(x),
+            None => return Err(NumbersError::NotNumber(i, x)),
+        }
+    }
+    Ok(out)
 }
 
 /// A JS option value as JSON, for serde.
-fn json_value(key: &str, v: &JsValue) -> Result<Value> {
+fn json_value(key: &str, v: &JsValue) -> WasmResult<Value> {
     if v.is_null() {
         return Ok(Value::Null);
     }
@@ -296,35 +445,47 @@ fn json_value(key: &str, v: &JsValue) -> Result<Value> {
         return Ok(Value::Bool(b));
     }
     if let Some(x) = v.as_f64() {
-        return json_number(key, x);
+        return Ok(json_number(key, x)?);
     }
-    if let Some(s) = v.as_string() {
-        return Ok(Value::String(s));
-    }
-    if let Some(nums) = numbers_of(v) {
-        let nums = match nums {
-            Ok(nums) => nums,
-            Err(i) => return Err(bad_option(key, format!("element {i} is not a number"))),
+    if v.is_string() {
+        return match js::short_string(v, MAX_OPTION_CHARS) {
+            Some(s) => Ok(Value::String(s)),
+            None => Err(bad_option(
+                key,
+                format!("a string of more than {MAX_OPTION_CHARS} characters is no valid value"),
+            )
+            .into()),
         };
-        let mut out = Vec::with_capacity(nums.len());
-        for (i, x) in nums.into_iter().enumerate() {
-            if !x.is_finite() {
-                return Err(bad_option(
-                    key,
-                    format!("element {i} must be a finite number, got {x}"),
-                ));
-            }
-            out.push(json_number(key, x)?);
-        }
-        return Ok(Value::Array(out));
     }
-    Err(bad_option(
-        key,
-        format!(
-            "expected a number, string, boolean or array, got {}",
-            describe(v)
-        ),
-    ))
+    let nums = match numbers_of::<f64>(v, &format!("option '{key}'"), MAX_OPTION_NUMBERS, &|_| {
+        Ok(())
+    }) {
+        Ok(nums) => nums,
+        Err(NumbersError::Failed(f)) => return Err(f),
+        Err(NumbersError::NotNumber(i, _)) => {
+            return Err(bad_option(key, format!("element {i} is not a number")).into())
+        }
+        Err(NumbersError::NotArray) => {
+            return Err(bad_option(
+                key,
+                format!(
+                    "expected a number, string, boolean or array, got {}",
+                    describe(v)
+                ),
+            )
+            .into())
+        }
+    };
+    let mut out = Vec::with_capacity(nums.len());
+    for (i, x) in nums.into_iter().enumerate() {
+        if !x.is_finite() {
+            return Err(
+                bad_option(key, format!("element {i} must be a finite number, got {x}")).into(),
+            );
+        }
+        out.push(json_number(key, x)?);
+    }
+    Ok(Value::Array(out))
 }
 
 /// A finite JS number as JSON: an integer when it is one (so that integer
@@ -343,56 +504,33 @@ fn json_number(key: &str, x: f64) -> Result<Value> {
     Ok(Value::from(x))
 }
 
-/// A short description of a JS value's type, for error messages.
-pub(crate) fn describe(v: &JsValue) -> String {
-    if v.is_null() {
-        return "null".into();
-    }
-    if v.is_undefined() {
-        return "undefined".into();
-    }
-    if Array::is_array(v) {
-        return "an Array".into();
-    }
-    if v.is_function() {
-        return "a function".into();
-    }
-    if v.is_object() {
-        let ctor = Reflect::get(v, &"constructor".into())
-            .ok()
-            .and_then(|c| Reflect::get(&c, &"name".into()).ok())
-            .and_then(|n| n.as_string());
-        return match ctor {
-            Some(name) if !name.is_empty() => format!("a {name}"),
-            _ => "an object".into(),
-        };
-    }
-    if let Some(s) = v.as_string() {
-        return format!("the string \"{s}\"");
-    }
-    match v.as_f64() {
-        Some(x) => format!("the number {x}"),
-        None => v
-            .js_typeof()
-            .as_string()
-            .unwrap_or_else(|| "a value".into()),
-    }
-}
-
-/// Interleaved points: a `Float32Array` (copied once into wasm memory), or
-/// a `Float64Array` or `Array` of numbers (converted to f32).
-pub(crate) fn points_of(v: &JsValue) -> Result<Vec<f32>> {
-    if let Some(a) = v.dyn_ref::<Float32Array>() {
-        return Ok(a.to_vec());
-    }
-    match numbers_of(v) {
-        Some(Ok(nums)) => Ok(nums.into_iter().map(|x| x as f32).collect()),
-        Some(Err(i)) => Err(invalid(format!("points: element {i} is not a number"))),
-        None => Err(invalid(format!(
+/// Interleaved points, `stride` numbers each: a `Float32Array` (copied once
+/// into wasm memory), or a `Float64Array` or `Array` of numbers (converted
+/// to f32). More than [`MAX_POINTS`] points are refused before anything is
+/// allocated.
+pub(crate) fn points_of(v: &JsValue, stride: Stride) -> WasmResult<Vec<f32>> {
+    // A length that is no multiple of the stride is refused before the copy.
+    let whole = |len: usize| {
+        if len % stride == 0 {
+            Ok(())
+        } else {
+            Err(Error::BadLength { len, stride })
+        }
+    };
+    match numbers_of::<f32>(v, "points", MAX_POINTS.saturating_mul(stride), &whole) {
+        Ok(values) => Ok(values),
+        Err(NumbersError::Failed(f)) => Err(f),
+        Err(NumbersError::NotNumber(i, x)) => Err(invalid(format!(
+            "points: element {i} is not a number (got {})",
+            describe(&x)
+        ))
+        .into()),
+        Err(NumbersError::NotArray) => Err(invalid(format!(
             "points must be a Float32Array of interleaved x, y, z[, intensity] values \
              (or a Float64Array or Array of numbers), got {}",
             describe(v)
-        ))),
+        ))
+        .into()),
     }
 }
 
@@ -400,30 +538,33 @@ pub(crate) fn points_of(v: &JsValue) -> Result<Vec<f32>> {
 /// (`Float64Array`, `Float32Array`, `Array`) or an object with such an
 /// `elements` array (a three.js `Matrix4`); identity when `undefined` or
 /// `null`. Checked to be rigid.
-fn pose_of(v: &JsValue) -> Result<DMat4> {
+fn pose_of(v: &JsValue) -> WasmResult<DMat4> {
     const EXPECTED: &str =
         "expected 16 numbers (a column-major 4x4 matrix, three.js Matrix4.elements order)";
     if v.is_undefined() || v.is_null() {
         return Ok(DMat4::IDENTITY);
     }
     let mut raw = v.clone();
-    if raw.is_object() && !Array::is_array(&raw) && !ArrayBuffer::is_view(&raw) {
-        if let Ok(elements) = Reflect::get(&raw, &"elements".into()) {
-            if !elements.is_undefined() {
-                raw = elements;
-            }
+    let array = js::is_array(v).map_err(|e| Failure::thrown("reading option 'pose'", e))?;
+    if raw.is_object() && !array && !ArrayBuffer::is_view(&raw) {
+        let elements = js::get(&raw, "elements")
+            .map_err(|e| Failure::thrown("reading option 'pose'.elements", e))?;
+        if !elements.is_undefined() {
+            raw = elements;
         }
     }
-    let nums = match numbers_of(&raw) {
-        Some(Ok(nums)) => nums,
-        Some(Err(i)) => return Err(Error::BadPose(format!("element {i} is not a number"))),
-        None => return Err(Error::BadPose(format!("{EXPECTED}, got {}", describe(v)))),
+    let nums = match numbers_of::<f64>(&raw, "option 'pose'", MAX_OPTION_NUMBERS, &|_| Ok(())) {
+        Ok(nums) => nums,
+        Err(NumbersError::Failed(f)) => return Err(f),
+        Err(NumbersError::NotNumber(i, _)) => {
+            return Err(Error::BadPose(format!("element {i} is not a number")).into())
+        }
+        Err(NumbersError::NotArray) => {
+            return Err(Error::BadPose(format!("{EXPECTED}, got {}", describe(v))).into())
+        }
     };
     let Ok(cols) = <[f64; 16]>::try_from(nums.as_slice()) else {
-        return Err(Error::BadPose(format!(
-            "{EXPECTED}, got {} numbers",
-            nums.len()
-        )));
+        return Err(Error::BadPose(format!("{EXPECTED}, got {} numbers", nums.len())).into());
     };
     let m = DMat4::from_cols_array(&cols);
     check_rigid(&m)?;
@@ -687,5 +828,5 @@ pub(crate) fn ground_truth_array(polygons: &[GtPolygon]) -> Array {
 /// code is shared with snapshots, which keeps the wasm small).
 pub(crate) fn to_js<T: serde::Serialize>(value: &T) -> WasmResult<JsValue> {
     let text = serde_json::to_string(value)?;
-    JSON::parse(&text).map_err(|_| JsError::new("internal error: unparsable JSON"))
+    JSON::parse(&text).map_err(|_| Failure::new("internal error: unparsable JSON"))
 }

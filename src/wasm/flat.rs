@@ -82,7 +82,7 @@ pub fn detect_flat(
     #[wasm_bindgen(unchecked_param_type = "DetectOptions")] options: Option<JsValue>,
 ) -> WasmResult<Object> {
     let options = DetectOptions::from_js(&options.unwrap_or(JsValue::UNDEFINED))?;
-    let values = points_of(&points)?;
+    let values = points_of(&points, options.stride)?;
     let cloud = Cloud::from_flat(&values, options.stride)?;
     let found = crate::detect::detect(&cloud, &options.params)?;
     Ok(flat_object(&found.primitives))

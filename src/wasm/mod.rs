@@ -5,8 +5,13 @@
 //! - [`convert`]: JS values in (points, poses, options, read one way) and
 //!   plain JS objects out; its structs define the `.d.ts` interfaces, which
 //!   `build.rs` generates from them;
-//! - [`error`]: the boundary's error type, so that `?` converts;
+//! - [`js`]: every touch of a caller's JS value, made so that no JS
+//!   exception can cross a Rust frame (a getter, a Proxy trap, a detached
+//!   buffer);
 //! - [`flat`]: polygons as columns (`polygonsFlat`, `detectFlat`);
+//! - [`progress`]: `detectWithProgress`, a callback between detection rounds;
+//! - [`error`]: the boundary's error type, so that `?` converts; a value
+//!   thrown by the caller's code becomes an `Error` with it as `cause`;
 //! - [`scenario`]: the `Scenario` class;
 //! - [`sim`]: `simulate`, `Simulation` and its iterator;
 //! - here: the module start, `detect`, `defaultOptions`, `version`.
@@ -22,11 +27,12 @@
 mod convert;
 mod error;
 mod flat;
+mod js;
 mod progress;
 mod scenario;
 mod sim;
 
-pub use error::WasmResult;
+pub use error::{Failure, WasmResult};
 pub use scenario::JsScenario;
 pub use sim::{simulate, JsSimulation, ScanIterator};
 
@@ -123,14 +129,15 @@ const TS_PIPELINE_OPTIONS: &'static str =
 ///
 /// Returns the polygons (plain objects owned by JS), `bornScan`/`lastScan`
 /// 0. Throws an `Error` naming the problem on a length not divisible by the
-/// stride, a NaN or infinite coordinate, or a bad option.
+/// stride, a NaN or infinite coordinate, more than 2^24 points, a detached
+/// buffer, or a bad option.
 #[wasm_bindgen(unchecked_return_type = "Polygon[]")]
 pub fn detect(
     #[wasm_bindgen(unchecked_param_type = "Float32Array")] points: JsValue,
     #[wasm_bindgen(unchecked_optional_param_type = "DetectOptions")] options: Option<JsValue>,
 ) -> WasmResult<Array> {
     let options = DetectOptions::from_js(&options.unwrap_or(JsValue::UNDEFINED))?;
-    let values = points_of(&points)?;
+    let values = points_of(&points, options.stride)?;
     let cloud = Cloud::from_flat(&values, options.stride)?;
     let found = crate::detect::detect(&cloud, &options.params)?;
     Ok(polygons_array(&found.primitives))
@@ -141,10 +148,20 @@ pub fn detect(
 /// populate a GUI.
 #[wasm_bindgen(js_name = defaultOptions, unchecked_return_type = "Required<Omit<PipelineOptions, \"preset\">>")]
 pub fn default_options(
-    #[wasm_bindgen(unchecked_optional_param_type = "Preset")] preset: Option<String>,
+    #[wasm_bindgen(unchecked_optional_param_type = "Preset")] preset: Option<JsValue>,
 ) -> WasmResult<JsValue> {
-    let params = Params::preset(preset.as_deref().unwrap_or("gpp2"))?;
-    to_js(&params)
+    let name = if let Some(preset) = preset {
+        // A preset name is short: a long string is refused before it is copied.
+        js::short_string(&preset, 16).ok_or_else(|| {
+            error::bad_option(
+                "preset",
+                format!("expected 'gpp1' or 'gpp2', got {}", js::describe(&preset)),
+            )
+        })?
+    } else {
+        "gpp2".to_string()
+    };
+    to_js(&Params::preset(&name)?)
 }
 
 /// The crate version (semver string).

@@ -1,10 +1,12 @@
 //! `detectWithProgress`: one-shot detection that reports after each round to
 //! a JS callback and stops when the callback says so. The callback is called
 //! through js-sys's `Function::call1`, a `catch` import: a callback that
-//! throws ends the detection and its exception is rethrown to the caller,
-//! with no unwinding through the wasm (the module stays usable).
+//! throws ends the detection, with no unwinding through the wasm (the module
+//! stays usable), and the caller gets an `Error` with the thrown value as its
+//! `cause`, as for every other value user code throws.
 
 use super::convert::{points_of, polygons_array, DetectOptions};
+use super::error::{Failure, WasmResult};
 use crate::cloud::Cloud;
 use crate::detect::{detect_with_progress, Progress};
 use js_sys::{Array, Function, Object, Reflect};
@@ -15,8 +17,8 @@ use wasm_bindgen::prelude::*;
 /// points, polygons })` after each round of the cascade (`pointsLeft` falls
 /// towards 0; the rounds' count is not known in advance). `onProgress`
 /// returning `false` stops the detection there: it then throws an `Error`
-/// saying so. An exception thrown by `onProgress` ends the detection and is
-/// rethrown as it is. A detection that runs to its end gives what `detect`
+/// saying so. An exception thrown by `onProgress` ends the detection: the
+/// `Error` thrown then has it as `cause`. A detection that runs to its end gives what `detect`
 /// gives.
 #[wasm_bindgen(js_name = detectWithProgress, unchecked_return_type = "Polygon[]")]
 pub fn detect_with_progress_js(
@@ -24,13 +26,15 @@ pub fn detect_with_progress_js(
     #[wasm_bindgen(unchecked_param_type = "DetectOptions | undefined")] options: JsValue,
     #[wasm_bindgen(unchecked_param_type = "(progress: DetectProgress) => boolean | void")]
     on_progress: Function,
-) -> Result<Array, JsValue> {
+) -> WasmResult<Array> {
     if !on_progress.is_function() {
-        return Err(JsError::new("detectWithProgress: onProgress must be a function").into());
+        return Err(Failure::new(
+            "detectWithProgress: onProgress must be a function",
+        ));
     }
-    let options = DetectOptions::from_js(&options).map_err(boundary)?;
-    let values = points_of(&points).map_err(boundary)?;
-    let cloud = Cloud::from_flat(&values, options.stride).map_err(boundary)?;
+    let options = DetectOptions::from_js(&options)?;
+    let values = points_of(&points, options.stride)?;
+    let cloud = Cloud::from_flat(&values, options.stride)?;
     let mut thrown: Option<JsValue> = None;
     let mut last = 0;
     let mut report = |at: &Progress| {
@@ -44,22 +48,19 @@ pub fn detect_with_progress_js(
             }
         }
     };
-    let found = detect_with_progress(&cloud, &options.params, &mut report).map_err(boundary)?;
+    let found = detect_with_progress(&cloud, &options.params, &mut report)?;
     if let Some(e) = thrown {
-        return Err(e);
+        return Err(Failure::thrown(
+            &format!("detectWithProgress: onProgress after round {last}"),
+            e,
+        ));
     }
     match found {
         Some(found) => Ok(polygons_array(&found.primitives)),
-        None => Err(JsError::new(&format!(
+        None => Err(Failure::new(format!(
             "detectWithProgress: stopped by onProgress after round {last}"
-        ))
-        .into()),
+        ))),
     }
-}
-
-/// A core or binding error as the thrown JS `Error` (as every export's).
-fn boundary(e: crate::error::Error) -> JsValue {
-    JsError::from(e).into()
 }
 
 fn progress_object(at: &Progress) -> JsValue {

@@ -1,18 +1,21 @@
 //! The `Scenario` class: the live map, one scan at a time.
 
 use super::convert::{
-    describe, mesh_object, points_of, polygons_array, to_js, ScanOptions, ScenarioOptions,
-    MAX_SAFE_INTEGER,
+    mesh_object, points_of, polygons_array, to_js, ScanOptions, ScenarioOptions, MAX_SAFE_INTEGER,
 };
-use super::error::{invalid, WasmResult};
-use crate::error::Result;
+use super::error::{invalid, Failure, WasmResult};
+use super::js::{self, describe};
 use crate::mesh;
-use crate::scenario::Scenario;
-use js_sys::{Array, Object, Uint32Array};
+use crate::scenario::{Scenario, MAX_SNAPSHOT_BYTES};
+use js_sys::{Array, JsString, Object, Uint32Array};
+use std::cell::{Ref, RefCell, RefMut};
 use wasm_bindgen::prelude::*;
+use wasm_bindgen::JsCast;
 
 const FREED_SCENARIO: &str =
     "this Scenario was freed (free() was called): its wasm memory is released; create a new one";
+const BUSY_SCENARIO: &str =
+    "this Scenario is busy: a call on it has not returned yet (a callback re-entered it)";
 
 /// The live map: scans arrive one at a time and update a list of planar
 /// polygons (the paper's Algorithm 2: expansion of existing polygons,
@@ -21,19 +24,46 @@ const FREED_SCENARIO: &str =
 /// Owns wasm memory: call `free()` when done (or rely on garbage
 /// collection). Every result it returns is a plain JS value owned by JS.
 /// `JSON.stringify(scenario)` gives its snapshot (through `toJSON()`).
+///
+/// Every method takes `&self` and reads and checks all its arguments
+/// before it borrows the core scenario: the arguments' getters and Proxy
+/// traps may call back into this object (even `free()` it), and a failed
+/// call leaves the scenario exactly as it was.
 #[wasm_bindgen(js_name = Scenario)]
 pub struct JsScenario {
-    inner: Option<Scenario>,
+    inner: RefCell<Option<Scenario>>,
 }
 
 impl JsScenario {
-    pub(super) fn get(&self) -> Result<&Scenario> {
-        self.inner.as_ref().ok_or_else(|| invalid(FREED_SCENARIO))
+    fn of(scenario: Scenario) -> JsScenario {
+        JsScenario {
+            inner: RefCell::new(Some(scenario)),
+        }
     }
 
-    fn get_mut(&mut self) -> Result<&mut Scenario> {
-        self.inner.as_mut().ok_or_else(|| invalid(FREED_SCENARIO))
+    /// The scenario, or an `Error` when it was freed or is busy.
+    pub(super) fn get(&self) -> WasmResult<Ref<'_, Scenario>> {
+        let inner = self.inner.try_borrow().map_err(|_| busy())?;
+        Ref::filter_map(inner, Option::as_ref).map_err(|_| freed())
     }
+
+    /// The scenario, mutable.
+    fn get_mut(&self) -> WasmResult<RefMut<'_, Scenario>> {
+        let inner = self.inner.try_borrow_mut().map_err(|_| busy())?;
+        RefMut::filter_map(inner, Option::as_mut).map_err(|_| freed())
+    }
+}
+
+#[cold]
+#[inline(never)]
+fn freed() -> Failure {
+    Failure::new(FREED_SCENARIO)
+}
+
+#[cold]
+#[inline(never)]
+fn busy() -> Failure {
+    Failure::new(BUSY_SCENARIO)
 }
 
 #[wasm_bindgen(js_class = Scenario)]
@@ -46,8 +76,7 @@ impl JsScenario {
         #[wasm_bindgen(unchecked_optional_param_type = "ScenarioOptions")] options: Option<JsValue>,
     ) -> WasmResult<JsScenario> {
         let options = ScenarioOptions::from_js(&options.unwrap_or(JsValue::UNDEFINED))?;
-        let inner = Scenario::new(options.params)?;
-        Ok(JsScenario { inner: Some(inner) })
+        Ok(JsScenario::of(Scenario::new(options.params)?))
     }
 
     /// Add a scan and update the map.
@@ -60,17 +89,20 @@ impl JsScenario {
     ///
     /// Returns what the scan did. Throws on a length not divisible by the
     /// stride, a NaN or infinite coordinate, a pose that is not 16 numbers
-    /// or not rigid, an unknown option; the scenario is unchanged then.
+    /// or not rigid, a point beyond 1e9 m after the pose, more than
+    /// 2^24 points, an unknown option, a detached buffer; the scenario is
+    /// unchanged then.
     #[wasm_bindgen(js_name = addScan, unchecked_return_type = "ScanReport")]
     pub fn add_scan(
-        &mut self,
+        &self,
         #[wasm_bindgen(unchecked_param_type = "Float32Array")] points: JsValue,
         #[wasm_bindgen(unchecked_optional_param_type = "ScanOptions")] options: Option<JsValue>,
     ) -> WasmResult<JsValue> {
-        let scenario = self.get_mut()?;
         let options = ScanOptions::from_js(&options.unwrap_or(JsValue::UNDEFINED))?;
-        let values = points_of(&points)?;
-        let report = scenario.add_scan(&values, options.stride, &options.pose)?;
+        let values = points_of(&points, options.stride)?;
+        let report = self
+            .get_mut()?
+            .add_scan(&values, options.stride, &options.pose)?;
         to_js(&report)
     }
 
@@ -120,19 +152,22 @@ impl JsScenario {
     /// exactly as if never stopped. Called by `JSON.stringify(scenario)`.
     #[wasm_bindgen(js_name = toJSON, unchecked_return_type = "ScenarioSnapshot")]
     pub fn to_json(&self) -> WasmResult<JsValue> {
-        let scenario = self.get()?;
-        let p = scenario.params();
-        for (key, v) in [("seed", p.seed), ("maxWork", p.max_work)] {
-            if v as f64 > MAX_SAFE_INTEGER {
-                return Err(invalid(format!(
-                    "snapshot: option '{key}' is {v}, above 2^53, which a JS number cannot hold \
-                     exactly; use toJSONString()"
-                ))
-                .into());
+        let text = {
+            let scenario = self.get()?;
+            let p = scenario.params();
+            for (key, v) in [("seed", p.seed), ("maxWork", p.max_work)] {
+                if v as f64 > MAX_SAFE_INTEGER {
+                    return Err(invalid(format!(
+                        "snapshot: option '{key}' is {v}, above 2^53, which a JS number cannot \
+                         hold exactly; use toJSONString()"
+                    ))
+                    .into());
+                }
             }
-        }
-        js_sys::JSON::parse(&scenario.to_json())
-            .map_err(|_| JsError::new("snapshot: the state could not be serialised"))
+            scenario.to_json()
+        };
+        js_sys::JSON::parse(&text)
+            .map_err(|_| Failure::new("snapshot: the state could not be serialised"))
     }
 
     /// The snapshot as a JSON string (exact for every value).
@@ -143,18 +178,20 @@ impl JsScenario {
 
     /// Restore a scenario from `toJSON()` output (an object, e.g. after
     /// `JSON.parse`) or `toJSONString()` output (a string). Throws when it is
-    /// not a valid snapshot.
+    /// not a valid snapshot (see `Scenario::from_json` in the Rust docs for
+    /// what is checked) or its JSON text is longer than 2^28 characters.
     #[wasm_bindgen(js_name = fromJSON)]
     pub fn from_json(
         #[wasm_bindgen(unchecked_param_type = "ScenarioSnapshot | string")] snapshot: JsValue,
     ) -> WasmResult<JsScenario> {
-        let text = if let Some(s) = snapshot.as_string() {
-            s
-        } else if snapshot.is_object() && !Array::is_array(&snapshot) {
+        let array =
+            js::is_array(&snapshot).map_err(|e| Failure::thrown("reading the snapshot", e))?;
+        let json = if snapshot.is_string() {
+            snapshot.clone()
+        } else if snapshot.is_object() && !array {
             js_sys::JSON::stringify(&snapshot)
-                .ok()
-                .and_then(|s| s.as_string())
-                .ok_or_else(|| invalid("not a polyscene snapshot: it cannot be turned into JSON"))?
+                .map_err(|e| Failure::thrown("not a polyscene snapshot: JSON.stringify of it", e))?
+                .into()
         } else {
             return Err(invalid(format!(
                 "not a polyscene snapshot: expected the object from toJSON() or its JSON string, \
@@ -163,14 +200,29 @@ impl JsScenario {
             ))
             .into());
         };
-        let inner = Scenario::from_json(&text)?;
-        Ok(JsScenario { inner: Some(inner) })
+        // The length is checked before the text is copied into wasm memory.
+        let text = match json.dyn_ref::<JsString>().filter(|_| json.is_string()) {
+            Some(s) if s.length() as usize <= MAX_SNAPSHOT_BYTES => json.as_string(),
+            Some(s) => {
+                return Err(invalid(format!(
+                    "not a polyscene snapshot: its JSON text has {} characters, more than the \
+                     {MAX_SNAPSHOT_BYTES} a snapshot may have",
+                    s.length()
+                ))
+                .into())
+            }
+            None => None,
+        };
+        let text =
+            text.ok_or_else(|| invalid("not a polyscene snapshot: it cannot be turned into JSON"))?;
+        Ok(JsScenario::of(Scenario::from_json(&text)?))
     }
 
     /// Release the wasm memory now. Later calls on this object throw an
     /// `Error` saying it was freed; calling `free()` again does nothing.
     #[wasm_bindgen(js_name = free)]
-    pub fn release(&mut self) {
-        self.inner = None;
+    pub fn release(&self) -> WasmResult<()> {
+        *self.inner.try_borrow_mut().map_err(|_| busy())? = None;
+        Ok(())
     }
 }

@@ -3,6 +3,7 @@
 
 use super::convert::{ground_truth_array, scan_object, set, SimulateOptions};
 use super::error::{bad_option, invalid, WasmResult};
+use super::js::describe;
 use crate::error::Result;
 use crate::sim::{Drive, Layout, SensorModel};
 use js_sys::{Array, Object, Reflect};
@@ -115,15 +116,27 @@ impl JsSimulation {
 
     /// Scan `index` (0 to `length - 1`), without moving the cursor.
     #[wasm_bindgen(unchecked_return_type = "SimulatedScan")]
-    pub fn scan(&self, index: f64) -> WasmResult<Object> {
+    pub fn scan(
+        &self,
+        #[wasm_bindgen(unchecked_param_type = "number")] index: JsValue,
+    ) -> WasmResult<Object> {
         let state = self.get()?;
         let n = state.drive.len();
+        // Read as a number here, not converted by the glue (which would run
+        // an object's valueOf).
+        let Some(index) = index.as_f64() else {
+            return Err(bad_option(
+                "scan",
+                format!("the index must be a number, got {}", describe(&index)),
+            )
+            .into());
+        };
         if !(index.fract() == 0.0 && index >= 0.0 && index < n as f64) {
             return Err(bad_option(
                 "scan",
                 format!(
                     "index {index} is out of range: this drive has {n} scans (0 to {})",
-                    n - 1
+                    n.saturating_sub(1)
                 ),
             )
             .into());

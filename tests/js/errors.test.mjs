@@ -195,3 +195,70 @@ test("simulate: options and ranges", () => {
   sim.free();
   stillWorks();
 });
+
+test("hostile arguments: detached buffers, Proxies, throwing getters; the Scenario stays usable and unchanged", () => {
+  const s = new ps.Scenario();
+  const pose = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -5, -5, -1.8, 1];
+  s.addScan(floor(), { pose });
+  const before = s.toJSONString();
+  // What a worker holds after postMessage(msg, [points.buffer]).
+  const gone = new Float32Array(9);
+  structuredClone(gone.buffer, { transfer: [gone.buffer] });
+  const e = throwsError(assert, () => s.addScan(gone), /points/, /detached/, /postMessage/);
+  assert.ok(e.cause instanceof TypeError, "the TypeError is the cause");
+  throwsError(assert, () => s.addScan(new Proxy(new Float32Array(9), {})), /points must be a Float32Array/, /Proxy/);
+  const arr = [0, 0, 0];
+  Object.defineProperty(arr, 1, { get() { throw 42; } });
+  // Values thrown by the caller's own code come back as an Error with the value as cause.
+  for (const [call, pattern, cause] of [
+    [() => s.addScan(arr), /reading points\[1\] threw the number 42/, 42],
+    [() => s.addScan(floor(3), { get stride() { throw undefined; } }), /reading addScan options.stride threw undefined/, undefined],
+    [() => s.addScan(floor(3), new Proxy({}, { ownKeys() { throw "no keys"; } })), /listing the keys of addScan options/, "no keys"],
+    [() => new ps.Scenario({ get minArea() { throw 7n; } }), /Scenario options.minArea/, 7n],
+    [() => ps.Scenario.fromJSON({ toJSON() { throw 3; } }), /not a polyscene snapshot/, 3],
+  ]) {
+    const err = throwsError(assert, call, pattern);
+    assert.ok("cause" in err, `${err.message}: a cause`);
+    assert.equal(err.cause, cause);
+  }
+  const sym = Symbol("thrown");
+  const err = throwsError(assert, () => ps.detect(floor(3), { get seed() { throw sym; } }), /a symbol/);
+  assert.equal(err.cause, sym);
+  // A getter that re-enters the Scenario (or frees it) breaks nothing.
+  throwsError(assert, () => s.addScan(floor(3), { get stride() { s.polygons(); throw new Error("mine"); } }), /Error: mine/);
+  assert.equal(s.toJSONString(), before, "every failed call left the scenario byte-identical");
+  assert.equal(s.addScan(floor(), { pose }).polygonCount, 1, "and it still takes scans");
+  const t = new ps.Scenario();
+  throwsError(assert, () => t.addScan(floor(3), { get stride() { t.free(); return 3; } }), /Scenario was freed/);
+  s.free();
+  // Each pass-through exception once leaked wasm stack; after ~1,000 the module trapped.
+  for (let i = 0; i < 3000; i++) {
+    try {
+      ps.detect(new Proxy(new Float32Array(9), {}));
+    } catch {}
+  }
+  stillWorks();
+});
+
+test("defaultOptions refuses non-strings; huge inputs are refused before they are allocated", () => {
+  for (const v of [{}, 5, true, Symbol(), 1n, { length: -1 }, { length: 1e9 }, [], "x".repeat(1e6)]) {
+    throwsError(assert, () => ps.defaultOptions(v), /option 'preset'/, /gpp1/);
+  }
+  assert.equal(ps.defaultOptions(null).minArea, ps.defaultOptions("gpp2").minArea);
+  // 2^24 points at most (stride 3: 50,331,648 numbers), checked from the length alone.
+  throwsError(assert, () => ps.detect(new Float32Array(3 * 2 ** 24 + 3)), /points/, /50331651 numbers is more than the 50331648/);
+  const big = [];
+  big.length = 2 ** 32 - 1;
+  throwsError(assert, () => ps.detect(big), /points/, /more than/);
+  throwsError(assert, () => ps.Scenario.fromJSON("x".repeat(2 ** 28 + 1)), /not a polyscene snapshot/, /268435456/);
+  stillWorks();
+});
+
+test("a snapshot with a vertex at -1e200 m is refused", () => {
+  const s = new ps.Scenario();
+  s.addScan(floor(), { pose: [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -5, -5, -1.8, 1] });
+  const snap = s.toJSON();
+  s.free();
+  snap.primitives[0].outline[0][0] = -1e200;
+  throwsError(assert, () => ps.Scenario.fromJSON(snap), /not a polyscene snapshot/, /polygon 0/, /outline vertex 0/);
+});
