@@ -14,6 +14,7 @@ use crate::cloud::Cloud;
 use crate::detect::{CascadePolicy, Detector, NO_PRIMITIVE};
 use crate::error::{Error, Result};
 use crate::params::Params;
+use crate::primindex::PrimIndex;
 use crate::primitive::Primitive;
 use crate::rng::Rng;
 use glam::{DMat4, DVec3};
@@ -78,6 +79,9 @@ pub struct Scenario {
     scans: u64,
     #[serde(skip)]
     last_labels: Vec<u32>,
+    /// Where the primitives are (derived, rebuilt after a restore).
+    #[serde(skip)]
+    index: PrimIndex,
 }
 
 impl Scenario {
@@ -90,6 +94,7 @@ impl Scenario {
             next_id: 0,
             scans: 0,
             last_labels: Vec::new(),
+            index: PrimIndex::default(),
         })
     }
 
@@ -141,10 +146,19 @@ impl Scenario {
 
         // 1. Expansion of existing primitives, in a cascade (id order).
         let te = clock::now_ms();
+        if p.expansion {
+            self.index.ensure(&self.primitives, p);
+        }
         if p.expansion && !self.primitives.is_empty() && n > 0 {
             let mut index = ScanIndex::new(&cloud.points, INDEX_VOXEL);
             let mut scratch = expand::Scratch::default();
-            for (k, prim) in self.primitives.iter_mut().enumerate() {
+            // Only the primitives a point of this scan could reach (exact:
+            // see `primindex`), in id order.
+            for id in self.index.near_cloud(cloud) {
+                let Ok(k) = self.primitives.binary_search_by_key(&id, |q| q.id) else {
+                    continue;
+                };
+                let prim = &mut self.primitives[k];
                 let stamp = k as u32 + 1;
                 let taken = expand::expand(
                     &mut scratch,
@@ -158,6 +172,7 @@ impl Scenario {
                     scan,
                 );
                 if taken > 0 {
+                    self.index.update(prim);
                     report.grown.push(prim.id);
                     report.explained_by_expansion += taken;
                 }
@@ -189,6 +204,7 @@ impl Scenario {
                 }
             }
             report.added.push(prim.id);
+            self.index.update(&prim);
             self.primitives.push(prim);
         }
         report.time_ms.detection = clock::now_ms() - td;
@@ -199,7 +215,8 @@ impl Scenario {
         if p.expansion {
             let mut changed = report.grown.clone();
             changed.extend_from_slice(&report.added);
-            report.merged = crate::merge::stats::merge_all(&mut self.primitives, &changed, p);
+            report.merged =
+                crate::merge::stats::merge_all(&mut self.primitives, &changed, p, &mut self.index);
             for ev in &report.merged {
                 for l in labels.iter_mut().filter(|l| **l == ev.removed) {
                     *l = ev.kept;
@@ -230,6 +247,15 @@ impl Scenario {
         let s: Scenario = serde_json::from_str(text)
             .map_err(|e| Error::Invalid(format!("not a polyscene snapshot: {e}")))?;
         s.params.validate()?;
+        // The scenario finds primitives by binary search on their ids.
+        if s.primitives.windows(2).any(|w| w[0].id >= w[1].id)
+            || s.primitives.last().is_some_and(|q| q.id >= s.next_id)
+        {
+            return Err(Error::Invalid(
+                "not a polyscene snapshot: primitive ids must increase and stay below nextId"
+                    .into(),
+            ));
+        }
         Ok(s)
     }
 }
