@@ -88,23 +88,57 @@ pub struct Detection {
 /// assert_eq!(found.primitives.len(), 1);
 /// assert!((found.primitives[0].area - 99.0).abs() < 3.0);
 /// ```
+///
+/// Fewer than `minInliers` points far from the bulk of the cloud (beyond
+/// 16 times its 10-90 % spread from the median, and beyond 10 km) cannot
+/// form a polygon: they are left out of the search, unlabelled, so they
+/// change nothing (the cloud's origin already ignores them). More of them
+/// may be a second site, and all points are searched.
 pub fn detect(cloud: &Cloud, params: &Params) -> Result<Detection> {
     params.validate()?;
+    let Some((median, reach)) =
+        crate::cloud::bulk_extent(cloud.points.iter().map(|p| p.as_dvec3()))
+    else {
+        return Ok(detect_all(cloud, params));
+    };
+    let far = |p: &glam::Vec3| (p.as_dvec3() - median).abs().max_element() > reach;
+    let outliers = cloud.points.iter().filter(|p| far(p)).count();
+    if outliers >= params.min_inliers {
+        return Ok(detect_all(cloud, params));
+    }
+    let kept: Vec<u32> = (0..cloud.len() as u32)
+        .filter(|&i| !far(&cloud.points[i as usize]))
+        .collect();
+    let bulk = Cloud {
+        origin: cloud.origin,
+        points: kept.iter().map(|&i| cloud.points[i as usize]).collect(),
+    };
+    let mut det = detect_all(&bulk, params);
+    let mut labels = vec![NO_PRIMITIVE; cloud.len()];
+    for (&i, &l) in kept.iter().zip(&det.labels) {
+        labels[i as usize] = l;
+    }
+    det.labels = labels;
+    Ok(det)
+}
+
+/// [`detect`] on every point (parameters validated).
+fn detect_all(cloud: &Cloud, params: &Params) -> Detection {
     let policy = CascadePolicy::one_shot();
     if let Some(v) = params.viewpoint {
         let det = Detector::new(params, policy);
-        return Ok(det.run(&cloud.points, cloud.origin, DVec3::from_array(v)));
+        return det.run(&cloud.points, cloud.origin, DVec3::from_array(v));
     }
     if sensor_could_stand_at(&cloud.points, -cloud.origin) {
         let det = Detector::new(params, policy);
-        return Ok(det.run(&cloud.points, cloud.origin, DVec3::ZERO));
+        return det.run(&cloud.points, cloud.origin, DVec3::ZERO);
     }
     // Seen from nowhere: normals face a point high above the centre.
     let n = cloud.points.len().max(1) as f64;
     let mean = cloud.points.iter().map(|p| p.as_dvec3()).sum::<DVec3>() / n;
     let viewpoint = cloud.origin + mean + DVec3::new(0.0, 0.0, 1e4);
     let det = Detector::new(params, policy.without_viewpoint());
-    Ok(det.run(&cloud.points, cloud.origin, viewpoint))
+    det.run(&cloud.points, cloud.origin, viewpoint)
 }
 
 /// The detection cascade: parameters (validated by the caller) and the
