@@ -58,7 +58,8 @@ pub(crate) fn expand(
     let (max_across, along) = (surface.expand_across, surface.expand_along);
     // The gate adapts to how flat this primitive really is.
     let sigma = prim.rms();
-    let across = (3.0 * sigma).clamp(0.03, max_across);
+    // (A gate option below 3 cm wins over the floor: `clamp` would panic.)
+    let across = (3.0 * sigma).clamp(0.03f64.min(max_across), max_across);
     let n = prim.plane.normal;
     let d_local = prim.plane.offset + n.dot(cloud.origin);
     let verts = prim.vertices();
