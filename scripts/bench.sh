@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Benchmarks, on demand (never part of make test): criterion natively (one
 # thread), then the wasm build under Node. Prints tables; see BENCHMARKS.md.
+# Not run here (hours on a shared machine): the soak of long drives,
+#   cargo run --release --example soak -- new 10000   (and: loop 10000)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export PATH="$HOME/.cargo/bin:$PATH"

@@ -136,9 +136,11 @@ impl Cloud {
     }
 
     /// Finite world points (read twice, never copied) around the centre of
-    /// their box rounded to whole metres.
+    /// their box rounded to whole metres; the box of the bulk of the points
+    /// when a few lie far from it (see [`robust_centre`]), so that f32 keeps
+    /// the bulk's precision.
     fn around_box_centre(points: impl Iterator<Item = DVec3> + Clone) -> Self {
-        let origin = bbox_centre(points.clone()).round();
+        let origin = robust_centre(points.clone()).round();
         Cloud {
             origin,
             points: points.map(|p| (p - origin).as_vec3()).collect(),
@@ -192,6 +194,57 @@ impl Cloud {
     pub fn world(&self, i: usize) -> DVec3 {
         self.origin + self.points[i].as_dvec3()
     }
+}
+
+/// Points farther than this from the bulk's median, per axis, in units of
+/// the bulk's spread (its 10th to 90th percentile), are outliers to
+/// [`robust_centre`].
+const OUTLIER_SPREADS: f64 = 16.0;
+
+/// Nor are points within this distance of the median (m) ever outliers:
+/// what a sensor sees, or a town, stays one bulk.
+const OUTLIER_FLOOR: f64 = 1e4;
+
+/// At most this many points (every k-th) estimate the median and spread.
+const ROBUST_SAMPLE: usize = 1 << 16;
+
+/// The centre of the points' bounding box, leaving out outliers (see
+/// [`bulk_extent`]). When there are none (the usual case) this is exactly
+/// the whole box's centre.
+fn robust_centre(points: impl Iterator<Item = DVec3> + Clone) -> DVec3 {
+    match bulk_extent(points.clone()) {
+        None => bbox_centre(points),
+        Some((median, reach)) => {
+            bbox_centre(points.filter(|p| (*p - median).abs().max_element() <= reach))
+        }
+    }
+}
+
+/// Where the bulk of `points` lies, when some lie outside it: the per-axis
+/// median and the reach around it (per axis, m) beyond which a point is an
+/// outlier (`OUTLIER_SPREADS` times the bulk's 10-90 % spread, at least
+/// `OUTLIER_FLOOR`). `None` when every point is in the bulk.
+pub(crate) fn bulk_extent(points: impl Iterator<Item = DVec3> + Clone) -> Option<(DVec3, f64)> {
+    let n = points.clone().count();
+    if n == 0 {
+        return None;
+    }
+    let step = n.div_ceil(ROBUST_SAMPLE);
+    let sample: Vec<DVec3> = points.clone().step_by(step).collect();
+    let (mut median, mut reach) = (DVec3::ZERO, 0.0f64);
+    for k in 0..3 {
+        let mut axis: Vec<f64> = sample.iter().map(|p| p[k]).collect();
+        let m = axis.len();
+        let at = |axis: &mut Vec<f64>, q: usize| *axis.select_nth_unstable_by(q, f64::total_cmp).1;
+        median[k] = at(&mut axis, m / 2);
+        let spread = at(&mut axis, m * 9 / 10) - at(&mut axis, m / 10);
+        reach = reach.max(spread * OUTLIER_SPREADS);
+    }
+    let reach = reach.max(OUTLIER_FLOOR);
+    let mut points = points;
+    points
+        .any(|p| (p - median).abs().max_element() > reach)
+        .then_some((median, reach))
 }
 
 fn bbox_centre(points: impl Iterator<Item = DVec3>) -> DVec3 {

@@ -33,6 +33,7 @@ mod clock;
 mod floor;
 mod hash;
 mod merge;
+mod primindex;
 mod raster;
 mod rng;
 

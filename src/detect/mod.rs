@@ -47,7 +47,7 @@ pub struct CascadeStep {
 }
 
 /// What one detection found.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct Detection {
     /// Accepted primitives, in the order found (ids 0, 1, ...).
     pub primitives: Vec<Primitive>,
@@ -89,9 +89,16 @@ pub struct Detection {
 /// assert_eq!(found.primitives.len(), 1);
 /// assert!((found.primitives[0].area - 99.0).abs() < 3.0);
 /// ```
+///
+/// Fewer than `minInliers` points far from the bulk of the cloud (beyond
+/// 16 times its 10-90 % spread from the median, and beyond 10 km) cannot
+/// form a polygon: they are left out of the search, unlabelled, so they
+/// change nothing (the cloud's origin already ignores them). More of them
+/// may be a second site, and all points are searched.
 pub fn detect(cloud: &Cloud, params: &Params) -> Result<Detection> {
-    let (det, viewpoint) = one_shot_detector(cloud, params)?;
-    Ok(det.run(&cloud.points, cloud.origin, viewpoint))
+    let found = detect_with_progress(cloud, params, &mut |_| ControlFlow::Continue(()))?;
+    // Never stopped, so always `Some`.
+    Ok(found.unwrap_or_default())
 }
 
 /// [`detect`] that calls `progress` after each round of the cascade (the
@@ -103,27 +110,57 @@ pub fn detect_with_progress(
     params: &Params,
     progress: &mut dyn FnMut(&Progress) -> ControlFlow<()>,
 ) -> Result<Option<Detection>> {
-    let (det, viewpoint) = one_shot_detector(cloud, params)?;
-    let rng = Rng::new(params.seed);
-    let (found, stopped) = det.run_inner(&cloud.points, cloud.origin, viewpoint, rng, progress);
-    Ok((!stopped).then_some(found))
+    params.validate()?;
+    let Some((median, reach)) =
+        crate::cloud::bulk_extent(cloud.points.iter().map(|p| p.as_dvec3()))
+    else {
+        return Ok(detect_all(cloud, params, progress));
+    };
+    let far = |p: &glam::Vec3| (p.as_dvec3() - median).abs().max_element() > reach;
+    let outliers = cloud.points.iter().filter(|p| far(p)).count();
+    if outliers >= params.min_inliers {
+        return Ok(detect_all(cloud, params, progress));
+    }
+    let kept: Vec<u32> = (0..cloud.len() as u32)
+        .filter(|&i| !far(&cloud.points[i as usize]))
+        .collect();
+    let bulk = Cloud {
+        origin: cloud.origin,
+        points: kept.iter().map(|&i| cloud.points[i as usize]).collect(),
+    };
+    let Some(mut det) = detect_all(&bulk, params, progress) else {
+        return Ok(None);
+    };
+    let mut labels = vec![NO_PRIMITIVE; cloud.len()];
+    for (&i, &l) in kept.iter().zip(&det.labels) {
+        labels[i as usize] = l;
+    }
+    det.labels = labels;
+    Ok(Some(det))
 }
 
-/// The detector and the viewpoint of a one-shot detection (see [`detect`]).
-fn one_shot_detector<'p>(cloud: &Cloud, params: &'p Params) -> Result<(Detector<'p>, DVec3)> {
-    params.validate()?;
+/// [`detect_with_progress`] on every point (parameters validated): `None`
+/// when `progress` stopped it.
+fn detect_all(
+    cloud: &Cloud,
+    params: &Params,
+    progress: &mut dyn FnMut(&Progress) -> ControlFlow<()>,
+) -> Option<Detection> {
     let policy = CascadePolicy::one_shot();
-    if let Some(v) = params.viewpoint {
-        return Ok((Detector::new(params, policy), DVec3::from_array(v)));
-    }
-    if sensor_could_stand_at(&cloud.points, -cloud.origin) {
-        return Ok((Detector::new(params, policy), DVec3::ZERO));
-    }
-    // Seen from nowhere: normals face a point high above the centre.
-    let n = cloud.points.len().max(1) as f64;
-    let mean = cloud.points.iter().map(|p| p.as_dvec3()).sum::<DVec3>() / n;
-    let viewpoint = cloud.origin + mean + DVec3::new(0.0, 0.0, 1e4);
-    Ok((Detector::new(params, policy.without_viewpoint()), viewpoint))
+    let (det, viewpoint) = if let Some(v) = params.viewpoint {
+        (Detector::new(params, policy), DVec3::from_array(v))
+    } else if sensor_could_stand_at(&cloud.points, -cloud.origin) {
+        (Detector::new(params, policy), DVec3::ZERO)
+    } else {
+        // Seen from nowhere: normals face a point high above the centre.
+        let n = cloud.points.len().max(1) as f64;
+        let mean = cloud.points.iter().map(|p| p.as_dvec3()).sum::<DVec3>() / n;
+        let viewpoint = cloud.origin + mean + DVec3::new(0.0, 0.0, 1e4);
+        (Detector::new(params, policy.without_viewpoint()), viewpoint)
+    };
+    let rng = Rng::new(params.seed);
+    let (found, stopped) = det.run_inner(&cloud.points, cloud.origin, viewpoint, rng, progress);
+    (!stopped).then_some(found)
 }
 
 /// Where a detection is, after one of its rounds ([`detect_with_progress`]).

@@ -2,6 +2,7 @@
 
 use super::{mergeable, MergeEvent};
 use crate::params::Params;
+use crate::primindex::PrimIndex;
 use crate::primitive::Primitive;
 use glam::DVec2;
 
@@ -28,11 +29,13 @@ fn absorb(a: &mut Primitive, b: &Primitive, params: &Params) {
 }
 
 /// Merge until no pair of primitives, one of them in `changed` (ids), is
-/// mergeable. `prims` is sorted by id and stays so.
+/// mergeable. `prims` is sorted by id and stays so; `index` (built over
+/// `prims`) names the partners worth testing and follows every merge.
 pub(crate) fn merge_all(
     prims: &mut Vec<Primitive>,
     changed: &[u32],
     params: &Params,
+    index: &mut PrimIndex,
 ) -> Vec<MergeEvent> {
     let mut events = Vec::new();
     let mut dirty: Vec<u32> = changed.to_vec();
@@ -40,11 +43,18 @@ pub(crate) fn merge_all(
     dirty.dedup();
     while let Some(id) = dirty.first().copied() {
         dirty.remove(0);
-        let Some(ia) = prims.iter().position(|p| p.id == id) else {
+        let Ok(ia) = prims.binary_search_by_key(&id, |p| p.id) else {
             continue;
         };
-        let partner =
-            (0..prims.len()).find(|&j| j != ia && mergeable(&prims[ia], &prims[j], params));
+        // The first partner in id order; the index leaves out only pairs
+        // `mergeable` refuses on their boxes.
+        let partner = match index.near_primitive(&prims[ia]) {
+            Some(ids) => ids
+                .iter()
+                .filter_map(|&b| prims.binary_search_by_key(&b, |p| p.id).ok())
+                .find(|&j| j != ia && mergeable(&prims[ia], &prims[j], params)),
+            None => (0..prims.len()).find(|&j| j != ia && mergeable(&prims[ia], &prims[j], params)),
+        };
         let Some(ib) = partner else {
             continue;
         };
@@ -61,6 +71,8 @@ pub(crate) fn merge_all(
             kept: kept_id,
             removed: b.id,
         });
+        index.update(&prims[keep]);
+        index.remove(b.id);
         prims.remove(gone);
         dirty.retain(|&d| d != b.id);
         // The survivor changed: check it again.

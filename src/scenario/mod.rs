@@ -15,6 +15,7 @@ use crate::cloud::Cloud;
 use crate::detect::{CascadePolicy, Detector, NO_PRIMITIVE};
 use crate::error::{Error, Result};
 use crate::params::Params;
+use crate::primindex::PrimIndex;
 use crate::primitive::Primitive;
 use crate::rng::Rng;
 use glam::{DMat4, DVec3};
@@ -84,6 +85,9 @@ pub struct Scenario {
     scans: u64,
     #[serde(skip)]
     last_labels: Vec<u32>,
+    /// Where the primitives are (derived, rebuilt after a restore).
+    #[serde(skip)]
+    index: PrimIndex,
 }
 
 impl Scenario {
@@ -96,6 +100,7 @@ impl Scenario {
             next_id: 0,
             scans: 0,
             last_labels: Vec::new(),
+            index: PrimIndex::default(),
         })
     }
 
@@ -147,10 +152,19 @@ impl Scenario {
 
         // 1. Expansion of existing primitives, in a cascade (id order).
         let te = clock::now_ms();
+        if p.expansion {
+            self.index.ensure(&self.primitives, p);
+        }
         if p.expansion && !self.primitives.is_empty() && n > 0 {
             let mut index = ScanIndex::new(&cloud.points, INDEX_VOXEL);
             let mut scratch = expand::Scratch::default();
-            for (k, prim) in self.primitives.iter_mut().enumerate() {
+            // Only the primitives a point of this scan could reach (exact:
+            // see `primindex`), in id order.
+            for id in self.index.near_cloud(cloud) {
+                let Ok(k) = self.primitives.binary_search_by_key(&id, |q| q.id) else {
+                    continue;
+                };
+                let prim = &mut self.primitives[k];
                 let stamp = k as u32 + 1;
                 let taken = expand::expand(
                     &mut scratch,
@@ -164,6 +178,7 @@ impl Scenario {
                     scan,
                 );
                 if taken > 0 {
+                    self.index.update(prim);
                     report.grown.push(prim.id);
                     report.explained_by_expansion += taken;
                 }
@@ -195,6 +210,7 @@ impl Scenario {
                 }
             }
             report.added.push(prim.id);
+            self.index.update(&prim);
             self.primitives.push(prim);
         }
         report.time_ms.detection = clock::now_ms() - td;
@@ -205,7 +221,8 @@ impl Scenario {
         if p.expansion {
             let mut changed = report.grown.clone();
             changed.extend_from_slice(&report.added);
-            report.merged = crate::merge::stats::merge_all(&mut self.primitives, &changed, p);
+            report.merged =
+                crate::merge::stats::merge_all(&mut self.primitives, &changed, p, &mut self.index);
             for ev in &report.merged {
                 for l in labels.iter_mut().filter(|l| **l == ev.removed) {
                     *l = ev.kept;
