@@ -116,15 +116,25 @@ fn help_on_every_command_succeeds_and_lists_its_options() {
 fn pipeline_options_change_the_result() {
     let dir = TempDir::new("options");
     let cloud = write_cloud(&dir);
-    let default = run(&args(&["detect", &cloud])).unwrap();
+    let default = run(&args(&["detect", &cloud, "--stride", "4"])).unwrap();
     assert!(polygon_count(&default) >= 1, "{default}");
     // No polygon is that large.
-    let none = run(&args(&["detect", &cloud, "--min-area", "1e9"])).unwrap();
+    let none = run(&args(&[
+        "detect",
+        &cloud,
+        "--stride",
+        "4",
+        "--min-area",
+        "1e9",
+    ]))
+    .unwrap();
     assert_eq!(polygon_count(&none), 0, "{none}");
     // Lists, booleans, names and integers parse as the JS options do.
     let out = run(&args(&[
         "detect",
         &cloud,
+        "--stride",
+        "4",
         "--viewpoint",
         "0,0,0.5",
         "--hull",
@@ -141,7 +151,10 @@ fn pipeline_options_change_the_result() {
     // --out writes the document instead.
     let path = dir.0.join("out.json");
     let path = path.to_string_lossy().into_owned();
-    assert_eq!(run(&args(&["detect", &cloud, "--out", &path])).unwrap(), "");
+    assert_eq!(
+        run(&args(&["detect", &cloud, "--stride", "4", "--out", &path])).unwrap(),
+        ""
+    );
     let written = std::fs::read_to_string(&path).unwrap();
     assert_eq!(polygon_count(&written), polygon_count(&default));
 }
@@ -168,12 +181,15 @@ fn a_bad_value_names_the_key() {
         ("--expansion", "maybe", "expansion"),
         ("--preset", "gpp3", "preset"),
     ] {
-        let e = run(&args(&["detect", &cloud, opt, value])).unwrap_err();
+        let e = run(&args(&["detect", &cloud, "--stride", "4", opt, value])).unwrap_err();
         let text = e.to_string();
         assert!(text.contains(&format!("'{key}'")), "{opt} {value}: {text}");
     }
     // Given twice, or with its --no- form: a usage error.
-    assert!(run(&args(&["detect", &cloud, "--seed", "1", "--seed", "2"])).is_err());
+    assert!(run(&args(&[
+        "detect", &cloud, "--stride", "4", "--seed", "1", "--seed", "2"
+    ]))
+    .is_err());
     assert!(run(&args(&[
         "replay",
         "d",
@@ -217,8 +233,19 @@ fn poses_give_the_viewpoint_of_an_accumulated_cloud() {
     )
     .unwrap();
     let poses = poses.to_string_lossy().into_owned();
-    let by_poses = run(&args(&["detect", &cloud, "--poses", &poses])).unwrap();
-    let by_viewpoint = run(&args(&["detect", &cloud, "--viewpoint", "0,0,0"])).unwrap();
+    let by_poses = run(&args(&[
+        "detect", &cloud, "--stride", "4", "--poses", &poses,
+    ]))
+    .unwrap();
+    let by_viewpoint = run(&args(&[
+        "detect",
+        &cloud,
+        "--stride",
+        "4",
+        "--viewpoint",
+        "0,0,0",
+    ]))
+    .unwrap();
     let strip = |s: &str| {
         let mut v: serde_json::Value = serde_json::from_str(s).unwrap();
         v["timeMs"] = serde_json::Value::Null;
@@ -226,7 +253,15 @@ fn poses_give_the_viewpoint_of_an_accumulated_cloud() {
     };
     assert_eq!(strip(&by_poses), strip(&by_viewpoint));
     assert!(polygon_count(&by_poses) >= 2);
-    let moved = run(&args(&["detect", &cloud, "--viewpoint", "30,0,-1.8"])).unwrap();
+    let moved = run(&args(&[
+        "detect",
+        &cloud,
+        "--stride",
+        "4",
+        "--viewpoint",
+        "30,0,-1.8",
+    ]))
+    .unwrap();
     assert_ne!(
         strip(&moved),
         strip(&by_poses),
@@ -237,6 +272,8 @@ fn poses_give_the_viewpoint_of_an_accumulated_cloud() {
     let e = run(&args(&[
         "detect",
         &cloud,
+        "--stride",
+        "4",
         "--poses",
         &bad.to_string_lossy(),
     ]))
@@ -245,6 +282,8 @@ fn poses_give_the_viewpoint_of_an_accumulated_cloud() {
     assert!(run(&args(&[
         "detect",
         &cloud,
+        "--stride",
+        "4",
         "--poses",
         &poses,
         "--viewpoint",
@@ -261,8 +300,8 @@ fn ondata_measures_the_polygons_against_their_cloud() {
     let cloud = write_cloud(&dir);
     let pred = dir.0.join("pred.json");
     let pred = pred.to_string_lossy().into_owned();
-    run(&args(&["detect", &cloud, "--out", &pred])).unwrap();
-    let out = run(&args(&["ondata", &pred, &cloud])).unwrap();
+    run(&args(&["detect", &cloud, "--stride", "4", "--out", &pred])).unwrap();
+    let out = run(&args(&["ondata", &pred, &cloud, "--stride", "4"])).unwrap();
     assert!(!out.contains('\n'), "one line: {out}");
     let doc: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert!(doc["share"].as_f64().unwrap() >= 0.95, "{out}");
@@ -278,10 +317,19 @@ fn ondata_measures_the_polygons_against_their_cloud() {
     .unwrap();
     let off = off.to_string_lossy().into_owned();
     let doc: serde_json::Value =
-        serde_json::from_str(&run(&args(&["ondata", &off, &cloud])).unwrap()).unwrap();
+        serde_json::from_str(&run(&args(&["ondata", &off, &cloud, "--stride", "4"])).unwrap())
+            .unwrap();
     assert_eq!(doc["share"].as_f64(), Some(0.0));
     assert_eq!(doc["polygons"][0]["id"].as_u64(), Some(7));
     assert_eq!(doc["polygons"][0]["share"].as_f64(), Some(0.0));
-    let e = run(&args(&["ondata", &off, &cloud, "--radius=-1"])).unwrap_err();
+    let e = run(&args(&[
+        "ondata",
+        &off,
+        &cloud,
+        "--stride",
+        "4",
+        "--radius=-1",
+    ]))
+    .unwrap_err();
     assert!(e.to_string().contains("--radius"), "{e}");
 }

@@ -379,14 +379,16 @@ pub(crate) fn describe(v: &JsValue) -> String {
     }
 }
 
-/// Interleaved points: a `Float32Array` (copied once into wasm memory), or
-/// a `Float64Array` or `Array` of numbers (converted to f32).
-pub(crate) fn points_of(v: &JsValue) -> Result<Vec<f32>> {
+/// Interleaved points: a `Float32Array` (copied once into wasm memory)
+/// stays f32; a `Float64Array` or `Array` of numbers stays f64, re-centred
+/// in f64 by the core before anything becomes f32 (map coordinates).
+pub(crate) fn points_of(v: &JsValue) -> Result<crate::cloud::Coordinates> {
+    use crate::cloud::Coordinates;
     if let Some(a) = v.dyn_ref::<Float32Array>() {
-        return Ok(a.to_vec());
+        return Ok(Coordinates::F32(a.to_vec()));
     }
     match numbers_of(v) {
-        Some(Ok(nums)) => Ok(nums.into_iter().map(|x| x as f32).collect()),
+        Some(Ok(nums)) => Ok(Coordinates::F64(nums)),
         Some(Err(i)) => Err(invalid(format!("points: element {i} is not a number"))),
         None => Err(invalid(format!(
             "points must be a Float32Array of interleaved x, y, z[, intensity] values \

@@ -5,6 +5,7 @@ use super::convert::{
     MAX_SAFE_INTEGER,
 };
 use super::error::{invalid, WasmResult};
+use crate::cloud::Coordinates;
 use crate::error::Result;
 use crate::mesh;
 use crate::scenario::Scenario;
@@ -53,7 +54,9 @@ impl JsScenario {
     /// Add a scan and update the map.
     ///
     /// `points`: interleaved x, y, z[, intensity] in the sensor frame
-    /// (metres), a `Float32Array` (copied once). `options.stride`: 3 or 4
+    /// (metres), a `Float32Array` (copied once; within 1e5 m of the sensor)
+    /// or a `Float64Array` (kept in f64: map coordinates, e.g. with the
+    /// identity pose). `options.stride`: 3 or 4
     /// (default 3). `options.pose`: world-from-sensor rigid transform, 16
     /// numbers column-major (three.js `Matrix4.elements` order, or a
     /// `Matrix4`), identity when omitted.
@@ -70,7 +73,10 @@ impl JsScenario {
         let scenario = self.get_mut()?;
         let options = ScanOptions::from_js(&options.unwrap_or(JsValue::UNDEFINED))?;
         let values = points_of(&points)?;
-        let report = scenario.add_scan(&values, options.stride, &options.pose)?;
+        let report = match &values {
+            Coordinates::F32(v) => scenario.add_scan(v, options.stride, &options.pose)?,
+            Coordinates::F64(v) => scenario.add_scan_f64(v, options.stride, &options.pose)?,
+        };
         to_js(&report)
     }
 
