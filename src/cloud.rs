@@ -345,3 +345,113 @@ fn bbox_centre(points: impl Iterator<Item = DVec3>) -> DVec3 {
         DVec3::ZERO
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 2 m grid of points at three heights, around `at`.
+    fn grid(at: DVec3) -> Vec<DVec3> {
+        let mut out = Vec::new();
+        for i in 0..20 {
+            for j in 0..20 {
+                for k in 0..3 {
+                    let p = DVec3::new(i as f64 * 0.37, j as f64 * 0.41, k as f64 * 0.9);
+                    out.push(at + p);
+                }
+            }
+        }
+        out
+    }
+
+    fn flat_f64(points: &[DVec3]) -> Vec<f64> {
+        points.iter().flat_map(|p| p.to_array()).collect()
+    }
+
+    #[test]
+    fn float32_beyond_the_limit_is_refused_with_the_fix() {
+        let utm = DVec3::new(500_000.0, 4_500_000.0, 50.0);
+        let far: Vec<f32> = grid(utm)
+            .iter()
+            .flat_map(|p| p.as_vec3().to_array())
+            .collect();
+        let e = Cloud::from_flat(&far, 3).unwrap_err();
+        assert!(matches!(e, Error::F32Precision { point: 0, .. }), "{e}");
+        let text = e.to_string();
+        for word in ["float32", "Float64Array", "float64", "500 mm"] {
+            assert!(text.contains(word), "{word}: {text}");
+        }
+        // The same through a scan's sensor frame (identity pose).
+        let e = Cloud::from_sensor(&far, 3, &DMat4::IDENTITY).unwrap_err();
+        assert!(matches!(e, Error::F32Precision { point: 0, .. }), "{e}");
+        // At the limit it is accepted; one step beyond it, point 1 is named.
+        let limit = MAX_F32_COORDINATE as f32;
+        assert!(Cloud::from_flat(&[limit, -limit, 0.0], 3).is_ok());
+        let e = Cloud::from_flat(&[0.0, 0.0, 0.0, 0.0, -1.0001e5, 0.0], 3).unwrap_err();
+        assert!(matches!(e, Error::F32Precision { point: 1, .. }), "{e}");
+        // Beyond every map it stays an out-of-range error.
+        let e = Cloud::from_flat(&[0.0, 0.0, 2e9], 3).unwrap_err();
+        assert!(matches!(e, Error::OutOfRange { .. }), "{e}");
+    }
+
+    /// Float64 map coordinates become the same local f32 points as the
+    /// cloud near the origin (the shift is whole metres), bit for bit.
+    #[test]
+    fn float64_map_coordinates_are_recentred_exactly() {
+        let near = grid(DVec3::new(3.0, -2.0, -1.5));
+        let shift = DVec3::new(500_000.0, 4_500_000.0, 50.0);
+        let far: Vec<DVec3> = near.iter().map(|p| *p + shift).collect();
+        let a = Cloud::from_flat_f64(&flat_f64(&near), 3).unwrap();
+        let b = Cloud::from_flat_f64(&flat_f64(&far), 3).unwrap();
+        assert_eq!(b.origin - a.origin, shift);
+        assert_eq!(a.points, b.points);
+        for (i, p) in far.iter().enumerate() {
+            assert!((b.world(i) - *p).length() < 1e-6);
+        }
+        // Stride 4 and bad input.
+        let four: Vec<f64> = far.iter().flat_map(|p| [p.x, p.y, p.z, 0.5]).collect();
+        assert_eq!(Cloud::from_flat_f64(&four, 4).unwrap().points, b.points);
+        assert!(matches!(
+            Cloud::from_flat_f64(&[0.0, f64::NAN, 0.0], 3),
+            Err(Error::NonFinite { point: 0 })
+        ));
+        assert!(matches!(
+            Cloud::from_flat_f64(&[0.0; 4], 3),
+            Err(Error::BadLength { .. })
+        ));
+        assert!(matches!(
+            Cloud::from_flat_f64(&[0.0, 0.0, 0.0, 1e10, 0.0, 0.0], 3),
+            Err(Error::OutOfRange { point: 1, .. })
+        ));
+    }
+
+    /// A float64 scan: around its sensor it takes the sensor origin (the
+    /// f32 path's, the same points); in map coordinates with the identity
+    /// pose it is re-centred on its points.
+    #[test]
+    fn float64_scans_keep_their_precision() {
+        let local = grid(DVec3::new(-5.0, -4.0, -1.8));
+        let pose = DMat4::from_rotation_translation(
+            glam::DQuat::from_rotation_z(0.4),
+            DVec3::new(500_010.0, 4_500_020.0, 51.0),
+        );
+        let f32s: Vec<f32> = local.iter().flat_map(|p| p.as_vec3().to_array()).collect();
+        let f64s: Vec<f64> = f32s.iter().map(|&v| v as f64).collect();
+        let a = Cloud::from_sensor(&f32s, 3, &pose).unwrap();
+        let b = Cloud::from_sensor_f64(&f64s, 3, &pose).unwrap();
+        assert_eq!((a.origin, &a.points), (b.origin, &b.points));
+        // The same scan in map coordinates, identity pose.
+        let world: Vec<f64> = (0..b.len()).flat_map(|i| b.world(i).to_array()).collect();
+        let c = Cloud::from_sensor_f64(&world, 3, &DMat4::IDENTITY).unwrap();
+        assert!((c.origin - pose.w_axis.truncate()).length() < 20.0);
+        for i in 0..c.len() {
+            assert!((c.world(i) - b.world(i)).length() < 1e-5);
+        }
+        assert!(Cloud::from_sensor_f64(&[0.0, 0.0, f64::INFINITY], 3, &pose).is_err());
+        let far = DMat4::from_translation(DVec3::new(2e9, 0.0, 0.0));
+        assert!(matches!(
+            Cloud::from_sensor_f64(&world, 3, &far),
+            Err(Error::BadPose(_))
+        ));
+    }
+}

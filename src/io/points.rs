@@ -60,7 +60,7 @@ impl Format {
             }
         }
         let text = |b: &u8| matches!(b, b'\t' | b'\n' | b'\r' | 0x20..=0x7e);
-        if head.len() >= 8 && head.iter().take(512).all(text) {
+        if head.len() >= 4 && head.iter().take(512).all(text) {
             return Err(
                 "a text file (ASCII XYZ or CSV?), which polyscene does not read: \
                         write the points as PLY, PCD or LAS, or as raw float32"
