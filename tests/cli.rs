@@ -551,44 +551,31 @@ fn every_format_gives_the_polygons_of_the_raw_local_cloud() {
     let count = polygon_count(&want);
     assert!(count >= 10, "{want}");
 
-    let cases: [(&str, Box<dyn Fn(&str)>, [f64; 3]); 6] = [
-        (
-            "utm.las",
-            Box::new(|p: &str| write_las(p, &points, UTM, false)),
-            UTM,
-        ),
-        (
-            "utm.laz",
-            Box::new(|p: &str| write_las(p, &points, UTM, true)),
-            UTM,
-        ),
-        (
-            "ascii.pcd",
-            Box::new(|p: &str| write_pcd(p, &points, None)),
-            [0.0; 3],
-        ),
-        (
-            "utm-binary.pcd",
-            Box::new(|p: &str| write_pcd(p, &points, Some(UTM))),
-            UTM,
-        ),
-        (
-            "ascii.ply",
-            Box::new(|p: &str| write_ply(p, &points, None)),
-            [0.0; 3],
-        ),
-        (
-            "utm-binary.ply",
-            Box::new(|p: &str| write_ply(p, &points, Some(UTM))),
-            UTM,
-        ),
-    ];
-    for (name, write, shift) in &cases {
+    for name in [
+        "utm.las",
+        "utm.laz",
+        "ascii.pcd",
+        "utm-binary.pcd",
+        "ascii.ply",
+        "utm-binary.ply",
+    ] {
         let path = path_of(&dir, name);
-        write(&path);
+        let shift = if name.starts_with("utm") {
+            UTM
+        } else {
+            [0.0; 3]
+        };
+        match name {
+            "utm.las" => write_las(&path, &points, UTM, false),
+            "utm.laz" => write_las(&path, &points, UTM, true),
+            "ascii.pcd" => write_pcd(&path, &points, None),
+            "utm-binary.pcd" => write_pcd(&path, &points, Some(UTM)),
+            "ascii.ply" => write_ply(&path, &points, None),
+            _ => write_ply(&path, &points, Some(UTM)),
+        }
         let vp = if shift[0] == 0.0 { local_vp } else { utm_vp };
         let got = detect(&path, &vp);
-        assert_same_polygons(name, &got, *shift, &want);
+        assert_same_polygons(name, &got, shift, &want);
         // A file with a header says what its points hold: no --stride.
         let e = run(&args(&["detect", &path, "--stride", "4"])).unwrap_err();
         assert!(e.to_string().contains("--stride"), "{e}");

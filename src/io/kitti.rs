@@ -377,7 +377,7 @@ impl Sequence {
         let (scans, skipped_empty): (Vec<ScanFile>, Vec<ScanFile>) =
             scans.into_iter().partition(|s| s.bytes > 0);
         let expected = if options.skip_missing {
-            last + 1 <= poses.len()
+            last < poses.len()
         } else {
             // Every number from 0 is there (empty ones perhaps left out):
             // one pose per scan file, as KITTI has.
