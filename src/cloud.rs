@@ -87,6 +87,7 @@ fn f32_precision_error(values: &[f32], stride: usize) -> Error {
             return Error::F32Precision {
                 point: i,
                 value: m as f64,
+                limit: MAX_F32_COORDINATE,
             };
         }
     }

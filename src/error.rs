@@ -37,6 +37,8 @@ pub enum Error {
         point: usize,
         /// Its largest absolute coordinate (m).
         value: f64,
+        /// The limit (m).
+        limit: f64,
     },
     /// A pose that is not a rigid transform, or of the wrong size.
     BadPose(String),
@@ -74,15 +76,19 @@ impl fmt::Display for Error {
                 "point {point} lies more than {limit:e} m from the world origin (after the \
                  pose, for a scan); coordinates are metres"
             ),
-            Error::F32Precision { point, value } => write!(
+            Error::F32Precision {
+                point,
+                value,
+                limit,
+            } => write!(
                 f,
                 "point {point} has a coordinate of {value:.6e} m in float32, which holds \
                  coordinates beyond {:e} m only to {} mm steps or coarser (here {} mm): \
                  planes would follow the rounding steps. Pass the points as float64 (a \
                  Float64Array in JS, Cloud::from_flat_f64 or Scenario::add_scan_f64 in \
                  Rust; the CLI keeps LAS, PLY and PCD doubles) or move them near the origin",
-                crate::cloud::MAX_F32_COORDINATE,
-                f32_step_mm(crate::cloud::MAX_F32_COORDINATE),
+                limit,
+                f32_step_mm(*limit),
                 f32_step_mm(*value),
             ),
             Error::BadPose(why) => write!(f, "invalid pose: {why}"),
