@@ -1,5 +1,14 @@
 //! Point clouds as the pipeline sees them: f32 coordinates relative to an f64
 //! origin, so that map coordinates (UTM is ~10^6 m) keep millimetre precision.
+//!
+//! Input comes as float32 or float64 ([`Coordinates`]). Float64 input is
+//! re-centred in f64 before anything becomes f32, so it may lie anywhere
+//! within [`MAX_COORDINATE`]. Float32 input must lie within
+//! [`MAX_F32_COORDINATE`] (10^5 m) of the world origin: beyond it float32
+//! holds a coordinate only to 8 mm steps or coarser (0.5 m at 4.5e6 m, a
+//! UTM northing), and detection would find planes along the rounding
+//! steps; such input is refused with an error that names the fix (pass
+//! float64, e.g. a `Float64Array`, or move the points near the origin).
 
 use crate::error::{Error, Result};
 use glam::{DMat4, DVec3, Vec3};
@@ -28,6 +37,82 @@ pub fn check_count(points: usize) -> Result<()> {
     Ok(())
 }
 
+/// Largest absolute coordinate accepted in float32 input (m): 10^5 m, where
+/// float32's steps are 7.8 mm, a tenth of the inlier distances. Farther
+/// points must come as float64 ([`Coordinates::F64`]).
+pub const MAX_F32_COORDINATE: f64 = 1e5;
+
+/// Interleaved point coordinates (`x, y, z[, intensity]`, stride 3 or 4)
+/// as a reader or a caller holds them.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Coordinates {
+    /// Float32 values: within [`MAX_F32_COORDINATE`] of the world origin.
+    F32(Vec<f32>),
+    /// Float64 values (map coordinates): re-centred in f64.
+    F64(Vec<f64>),
+}
+
+impl Coordinates {
+    /// Number of values (points times stride).
+    pub fn len(&self) -> usize {
+        match self {
+            Coordinates::F32(v) => v.len(),
+            Coordinates::F64(v) => v.len(),
+        }
+    }
+
+    /// No values?
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// World-frame cloud ([`Cloud::from_flat`] or [`Cloud::from_flat_f64`]).
+    pub fn cloud(&self, stride: usize) -> Result<Cloud> {
+        match self {
+            Coordinates::F32(v) => Cloud::from_flat(v, stride),
+            Coordinates::F64(v) => Cloud::from_flat_f64(v, stride),
+        }
+    }
+
+    /// Sensor-frame cloud moved by `pose` ([`Cloud::from_sensor`] or
+    /// [`Cloud::from_sensor_f64`]).
+    pub fn cloud_in_sensor_frame(&self, stride: usize, pose: &DMat4) -> Result<Cloud> {
+        match self {
+            Coordinates::F32(v) => Cloud::from_sensor(v, stride, pose),
+            Coordinates::F64(v) => Cloud::from_sensor_f64(v, stride, pose),
+        }
+    }
+
+    /// Point `i`'s `x, y, z` in f64 (`None` past the end).
+    pub fn point(&self, stride: usize, i: usize) -> Option<DVec3> {
+        let at = i.checked_mul(stride)?;
+        match self {
+            Coordinates::F32(v) => v
+                .get(at..at + 3)
+                .map(|p| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64)),
+            Coordinates::F64(v) => v.get(at..at + 3).map(|p| DVec3::new(p[0], p[1], p[2])),
+        }
+    }
+}
+
+/// The first point of float32 input with a coordinate beyond
+/// [`MAX_F32_COORDINATE`], as an error; called only when the largest
+/// coordinate is beyond it (and within [`MAX_COORDINATE`]).
+fn f32_precision_error(values: &[f32], stride: usize) -> Error {
+    let limit = MAX_F32_COORDINATE as f32;
+    for (i, p) in values.chunks_exact(stride).enumerate() {
+        let m = p[0].abs().max(p[1].abs()).max(p[2].abs());
+        if m > limit {
+            return Error::F32Precision {
+                point: i,
+                value: m as f64,
+                limit: MAX_F32_COORDINATE,
+            };
+        }
+    }
+    Error::Invalid("float32 coordinates beyond the precision limit".into())
+}
+
 /// The first point whose world coordinates lie beyond [`MAX_COORDINATE`].
 fn check_range(points: impl Iterator<Item = DVec3>) -> Result<()> {
     for (i, p) in points.enumerate() {
@@ -44,17 +129,20 @@ fn check_range(points: impl Iterator<Item = DVec3>) -> Result<()> {
 /// Check that a flat buffer has a valid stride and finite x, y, z; returns
 /// the largest absolute coordinate.
 pub fn check_finite(values: &[f32], stride: usize) -> Result<f32> {
+    check_layout(values.len(), stride)?;
+    largest_coordinate(values, stride)
+}
+
+/// A stride of 3 or 4 and a length that is a whole number of points.
+fn check_layout(len: usize, stride: usize) -> Result<()> {
     if stride != 3 && stride != 4 {
         return Err(Error::BadStride(stride));
     }
-    if values.len() % stride != 0 {
-        return Err(Error::BadLength {
-            len: values.len(),
-            stride,
-        });
+    if len % stride != 0 {
+        return Err(Error::BadLength { len, stride });
     }
-    check_count(values.len() / stride)?;
-    largest_coordinate(values, stride)
+    check_count(len / stride)?;
+    Ok(())
 }
 
 /// The largest absolute coordinate of the points (checked as in
@@ -125,13 +213,31 @@ impl Cloud {
         Ok(Self::around_box_centre(points.iter().copied()))
     }
 
-    /// From a flat f32 buffer (stride 3 or 4), world frame.
+    /// From a flat f32 buffer (stride 3 or 4), world frame. Coordinates must
+    /// lie within [`MAX_F32_COORDINATE`]: farther points are an
+    /// [`Error::F32Precision`] (pass them in f64, [`Cloud::from_flat_f64`]).
     pub fn from_flat(values: &[f32], stride: usize) -> Result<Self> {
         let largest = check_finite(values, stride)?;
         let at = |p: &[f32]| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
         if largest as f64 > MAX_COORDINATE {
             check_range(values.chunks_exact(stride).map(at))?;
         }
+        if largest as f64 > MAX_F32_COORDINATE {
+            return Err(f32_precision_error(values, stride));
+        }
+        Ok(Self::around_box_centre(values.chunks_exact(stride).map(at)))
+    }
+
+    /// From a flat f64 buffer (stride 3 or 4), world frame: re-centred in
+    /// f64 (the origin is the centre of the points' box rounded to whole
+    /// metres), so map coordinates keep sub-millimetre precision.
+    pub fn from_flat_f64(values: &[f64], stride: usize) -> Result<Self> {
+        check_layout(values.len(), stride)?;
+        let at = |p: &[f64]| DVec3::new(p[0], p[1], p[2]);
+        if let Some(i) = values.chunks_exact(stride).position(|p| !at(p).is_finite()) {
+            return Err(Error::NonFinite { point: i });
+        }
+        check_range(values.chunks_exact(stride).map(at))?;
         Ok(Self::around_box_centre(values.chunks_exact(stride).map(at)))
     }
 
@@ -149,16 +255,13 @@ impl Cloud {
 
     /// From a flat f32 buffer in a sensor frame and a world-from-sensor pose:
     /// the origin is the sensor position rounded to whole metres, and each
-    /// point is transformed in f64.
+    /// point is transformed in f64. Sensor-frame coordinates must lie within
+    /// [`MAX_F32_COORDINATE`] (else [`Error::F32Precision`]; see
+    /// [`Cloud::from_sensor_f64`]); the pose may move them anywhere within
+    /// [`MAX_COORDINATE`].
     pub fn from_sensor(values: &[f32], stride: usize, pose: &DMat4) -> Result<Self> {
         let largest = check_finite(values, stride)?;
-        check_rigid(pose)?;
-        let t = pose.w_axis.truncate();
-        if t.abs().max_element() > MAX_COORDINATE {
-            return Err(Error::BadPose(format!(
-                "its translation lies more than {MAX_COORDINATE:e} m from the world origin"
-            )));
-        }
+        let t = check_pose(pose)?;
         // A rotation keeps lengths: the points stay within |t| + sqrt(3)
         // times their largest coordinate, and only beyond that bound is
         // each one checked.
@@ -176,7 +279,48 @@ impl Cloud {
             }
             points.push((w - origin).as_vec3());
         }
+        if largest as f64 > MAX_F32_COORDINATE {
+            return Err(f32_precision_error(values, stride));
+        }
         Ok(Cloud { origin, points })
+    }
+
+    /// From a flat f64 buffer in a sensor frame (or a world frame, with the
+    /// identity pose) and a world-from-sensor pose, every step in f64. The
+    /// origin is the sensor position rounded to whole metres when every
+    /// point lies within [`MAX_F32_COORDINATE`] of it (a scan around its
+    /// sensor: the origin [`Cloud::from_sensor`] takes), else the centre of
+    /// the points' box rounded (points already in map coordinates).
+    pub fn from_sensor_f64(values: &[f64], stride: usize, pose: &DMat4) -> Result<Self> {
+        check_layout(values.len(), stride)?;
+        let t = check_pose(pose)?;
+        let mut world = Vec::with_capacity(values.len() / stride);
+        for (i, p) in values.chunks_exact(stride).enumerate() {
+            let v = DVec3::new(p[0], p[1], p[2]);
+            if !v.is_finite() {
+                return Err(Error::NonFinite { point: i });
+            }
+            let w = pose.transform_point3(v);
+            if !w.is_finite() || w.abs().max_element() > MAX_COORDINATE {
+                return Err(Error::OutOfRange {
+                    point: i,
+                    limit: MAX_COORDINATE,
+                });
+            }
+            world.push(w);
+        }
+        let sensor = t.round();
+        let near = world
+            .iter()
+            .all(|w| (*w - sensor).abs().max_element() <= MAX_F32_COORDINATE);
+        if near {
+            let points = world.iter().map(|w| (*w - sensor).as_vec3()).collect();
+            return Ok(Cloud {
+                origin: sensor,
+                points,
+            });
+        }
+        Ok(Self::around_box_centre(world.into_iter()))
     }
 
     /// Number of points.
@@ -247,6 +391,19 @@ pub(crate) fn bulk_extent(points: impl Iterator<Item = DVec3> + Clone) -> Option
         .then_some((median, reach))
 }
 
+/// A rigid pose whose translation lies within [`MAX_COORDINATE`]; returns
+/// the translation.
+fn check_pose(pose: &DMat4) -> Result<DVec3> {
+    check_rigid(pose)?;
+    let t = pose.w_axis.truncate();
+    if t.abs().max_element() > MAX_COORDINATE {
+        return Err(Error::BadPose(format!(
+            "its translation lies more than {MAX_COORDINATE:e} m from the world origin"
+        )));
+    }
+    Ok(t)
+}
+
 fn bbox_centre(points: impl Iterator<Item = DVec3>) -> DVec3 {
     let mut lo = DVec3::splat(f64::INFINITY);
     let mut hi = DVec3::splat(f64::NEG_INFINITY);
@@ -261,5 +418,115 @@ fn bbox_centre(points: impl Iterator<Item = DVec3>) -> DVec3 {
         (lo + hi) * 0.5
     } else {
         DVec3::ZERO
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 2 m grid of points at three heights, around `at`.
+    fn grid(at: DVec3) -> Vec<DVec3> {
+        let mut out = Vec::new();
+        for i in 0..20 {
+            for j in 0..20 {
+                for k in 0..3 {
+                    let p = DVec3::new(i as f64 * 0.37, j as f64 * 0.41, k as f64 * 0.9);
+                    out.push(at + p);
+                }
+            }
+        }
+        out
+    }
+
+    fn flat_f64(points: &[DVec3]) -> Vec<f64> {
+        points.iter().flat_map(|p| p.to_array()).collect()
+    }
+
+    #[test]
+    fn float32_beyond_the_limit_is_refused_with_the_fix() {
+        let utm = DVec3::new(500_000.0, 4_500_000.0, 50.0);
+        let far: Vec<f32> = grid(utm)
+            .iter()
+            .flat_map(|p| p.as_vec3().to_array())
+            .collect();
+        let e = Cloud::from_flat(&far, 3).unwrap_err();
+        assert!(matches!(e, Error::F32Precision { point: 0, .. }), "{e}");
+        let text = e.to_string();
+        for word in ["float32", "Float64Array", "float64", "500 mm"] {
+            assert!(text.contains(word), "{word}: {text}");
+        }
+        // The same through a scan's sensor frame (identity pose).
+        let e = Cloud::from_sensor(&far, 3, &DMat4::IDENTITY).unwrap_err();
+        assert!(matches!(e, Error::F32Precision { point: 0, .. }), "{e}");
+        // At the limit it is accepted; one step beyond it, point 1 is named.
+        let limit = MAX_F32_COORDINATE as f32;
+        assert!(Cloud::from_flat(&[limit, -limit, 0.0], 3).is_ok());
+        let e = Cloud::from_flat(&[0.0, 0.0, 0.0, 0.0, -1.0001e5, 0.0], 3).unwrap_err();
+        assert!(matches!(e, Error::F32Precision { point: 1, .. }), "{e}");
+        // Beyond every map it stays an out-of-range error.
+        let e = Cloud::from_flat(&[0.0, 0.0, 2e9], 3).unwrap_err();
+        assert!(matches!(e, Error::OutOfRange { .. }), "{e}");
+    }
+
+    /// Float64 map coordinates become the same local f32 points as the
+    /// cloud near the origin (the shift is whole metres), bit for bit.
+    #[test]
+    fn float64_map_coordinates_are_recentred_exactly() {
+        let near = grid(DVec3::new(3.0, -2.0, -1.5));
+        let shift = DVec3::new(500_000.0, 4_500_000.0, 50.0);
+        let far: Vec<DVec3> = near.iter().map(|p| *p + shift).collect();
+        let a = Cloud::from_flat_f64(&flat_f64(&near), 3).unwrap();
+        let b = Cloud::from_flat_f64(&flat_f64(&far), 3).unwrap();
+        assert_eq!(b.origin - a.origin, shift);
+        assert_eq!(a.points, b.points);
+        for (i, p) in far.iter().enumerate() {
+            assert!((b.world(i) - *p).length() < 1e-6);
+        }
+        // Stride 4 and bad input.
+        let four: Vec<f64> = far.iter().flat_map(|p| [p.x, p.y, p.z, 0.5]).collect();
+        assert_eq!(Cloud::from_flat_f64(&four, 4).unwrap().points, b.points);
+        assert!(matches!(
+            Cloud::from_flat_f64(&[0.0, f64::NAN, 0.0], 3),
+            Err(Error::NonFinite { point: 0 })
+        ));
+        assert!(matches!(
+            Cloud::from_flat_f64(&[0.0; 4], 3),
+            Err(Error::BadLength { .. })
+        ));
+        assert!(matches!(
+            Cloud::from_flat_f64(&[0.0, 0.0, 0.0, 1e10, 0.0, 0.0], 3),
+            Err(Error::OutOfRange { point: 1, .. })
+        ));
+    }
+
+    /// A float64 scan: around its sensor it takes the sensor origin (the
+    /// f32 path's, the same points); in map coordinates with the identity
+    /// pose it is re-centred on its points.
+    #[test]
+    fn float64_scans_keep_their_precision() {
+        let local = grid(DVec3::new(-5.0, -4.0, -1.8));
+        let pose = DMat4::from_rotation_translation(
+            glam::DQuat::from_rotation_z(0.4),
+            DVec3::new(500_010.0, 4_500_020.0, 51.0),
+        );
+        let f32s: Vec<f32> = local.iter().flat_map(|p| p.as_vec3().to_array()).collect();
+        let f64s: Vec<f64> = f32s.iter().map(|&v| v as f64).collect();
+        let a = Cloud::from_sensor(&f32s, 3, &pose).unwrap();
+        let b = Cloud::from_sensor_f64(&f64s, 3, &pose).unwrap();
+        assert_eq!((a.origin, &a.points), (b.origin, &b.points));
+        // The same scan in map coordinates, identity pose.
+        let world: Vec<f64> = (0..b.len()).flat_map(|i| b.world(i).to_array()).collect();
+        let c = Cloud::from_sensor_f64(&world, 3, &DMat4::IDENTITY).unwrap();
+        assert!((c.origin - pose.w_axis.truncate()).length() < 20.0);
+        for i in 0..c.len() {
+            assert!((c.world(i) - b.world(i)).length() < 1e-5);
+        }
+        assert!(Cloud::from_sensor_f64(&[0.0, 0.0, f64::INFINITY], 3, &pose).is_err());
+        let far = DMat4::from_translation(DVec3::new(2e9, 0.0, 0.0));
+        assert!(matches!(
+            Cloud::from_sensor_f64(&world, 3, &far),
+            Err(Error::BadPose(_))
+        ));
     }
 }

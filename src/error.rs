@@ -36,6 +36,17 @@ pub enum Error {
         /// The limit.
         limit: usize,
     },
+    /// A float32 coordinate beyond
+    /// [`MAX_F32_COORDINATE`](crate::cloud::MAX_F32_COORDINATE): float32
+    /// cannot hold it to the detection's tolerance; pass float64.
+    F32Precision {
+        /// Index of the point.
+        point: usize,
+        /// Its largest absolute coordinate (m).
+        value: f64,
+        /// The limit (m).
+        limit: f64,
+    },
     /// A pose that is not a rigid transform, or of the wrong size.
     BadPose(String),
     /// An option out of range or unknown.
@@ -77,6 +88,21 @@ impl fmt::Display for Error {
                 "{points} points is more than the {limit} one cloud may hold \
                  (the memory of a wasm instance is 4 GiB); split the cloud"
             ),
+            Error::F32Precision {
+                point,
+                value,
+                limit,
+            } => write!(
+                f,
+                "point {point} has a coordinate of {value:.6e} m in float32, which holds \
+                 coordinates beyond {:e} m only to {} mm steps or coarser (here {} mm): \
+                 planes would follow the rounding steps. Pass the points as float64 (a \
+                 Float64Array in JS, Cloud::from_flat_f64 or Scenario::add_scan_f64 in \
+                 Rust; the CLI keeps LAS, PLY and PCD doubles) or move them near the origin",
+                limit,
+                f32_step_mm(*limit),
+                f32_step_mm(*value),
+            ),
             Error::BadPose(why) => write!(f, "invalid pose: {why}"),
             Error::BadOption { key, reason } => write!(f, "option '{key}': {reason}"),
             Error::Io(why) => write!(f, "{why}"),
@@ -86,6 +112,13 @@ impl fmt::Display for Error {
 }
 
 impl std::error::Error for Error {}
+
+/// The spacing of float32 values at `x` (m), in millimetres, rounded.
+fn f32_step_mm(x: f64) -> f64 {
+    let x = (x.abs() as f32).max(f32::MIN_POSITIVE);
+    let step = f32::from_bits(x.to_bits() + 1) - x;
+    (step as f64 * 1e4).round() / 10.0
+}
 
 /// Shorthand for results with [`Error`].
 pub type Result<T> = std::result::Result<T, Error>;

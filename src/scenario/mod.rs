@@ -127,10 +127,29 @@ impl Scenario {
     }
 
     /// Add a scan: `points` interleaved with `stride` 3 or 4 in the sensor
-    /// frame, `pose` the world-from-sensor rigid transform.
+    /// frame, `pose` the world-from-sensor rigid transform. Float32 points
+    /// must lie within [`MAX_F32_COORDINATE`](crate::cloud::MAX_F32_COORDINATE)
+    /// of the sensor; points in map coordinates go through
+    /// [`Scenario::add_scan_f64`].
     pub fn add_scan(&mut self, points: &[f32], stride: usize, pose: &DMat4) -> Result<ScanReport> {
         let t0 = clock::now_ms();
         let cloud = Cloud::from_sensor(points, stride, pose)?;
+        let sensor = pose.w_axis.truncate();
+        Ok(self.add_cloud(&cloud, sensor, t0))
+    }
+
+    /// [`Scenario::add_scan`] for float64 points: every step up to the
+    /// per-scan origin in f64, so points already in map coordinates (with
+    /// the identity pose) keep their precision
+    /// ([`Cloud::from_sensor_f64`]).
+    pub fn add_scan_f64(
+        &mut self,
+        points: &[f64],
+        stride: usize,
+        pose: &DMat4,
+    ) -> Result<ScanReport> {
+        let t0 = clock::now_ms();
+        let cloud = Cloud::from_sensor_f64(points, stride, pose)?;
         let sensor = pose.w_axis.truncate();
         Ok(self.add_cloud(&cloud, sensor, t0))
     }

@@ -86,25 +86,25 @@ pub(crate) fn write_drive(dir: &Path, drive: &Drive, scans: usize) -> Result<()>
 }
 
 /// Read a dataset written by [`write_dataset`] (or any KITTI-style folder of
-/// stride-4 `.bin` scans with a `poses.txt`): scans sorted by file name,
+/// stride-4 `.bin` scans with a `poses.txt` of world-from-LiDAR poses):
+/// scans by number, which must run 0, 1, 2, ... (a gap would shift the
+/// poses; see [`io::kitti::scan_files`]),
 /// their labels where a `.label` file exists, the poses (one per scan), and
 /// the ground truth if `ground_truth.json` exists. Errors name the file.
 pub fn read_dataset(dir: &Path) -> Result<Dataset> {
-    let entries =
-        std::fs::read_dir(dir).map_err(|e| io_err(dir, format!("cannot list directory: {e}")))?;
-    let mut bins: Vec<(String, PathBuf)> = Vec::new();
-    for entry in entries {
-        let entry = entry.map_err(|e| io_err(dir, format!("cannot list directory: {e}")))?;
-        let path = entry.path();
-        if path.extension().is_some_and(|x| x == "bin") && path.is_file() {
-            let name = entry.file_name().to_string_lossy().into_owned();
-            bins.push((name, path));
-        }
-    }
-    if bins.is_empty() {
-        return Err(io_err(dir, "no .bin scans found"));
-    }
-    bins.sort();
+    // Numbered 0, 1, 2, ... without a gap or an empty file: line k of
+    // poses.txt goes with scan k.
+    let bins: Vec<(String, PathBuf)> = io::kitti::scan_files(dir, false, false)?
+        .into_iter()
+        .map(|s| {
+            let name = s
+                .path
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            (name, s.path)
+        })
+        .collect();
     let mut scans = Vec::with_capacity(bins.len());
     for (name, path) in bins {
         let points = io::read_bin(&path, 4)?;

@@ -17,7 +17,7 @@
 use super::error::{bad_option, invalid, Failure, WasmResult};
 use super::js::{self, describe};
 use crate::cloud::check_rigid;
-use crate::cloud::MAX_POINTS;
+use crate::cloud::{Coordinates, MAX_POINTS};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::params::Params;
@@ -505,10 +505,11 @@ fn json_number(key: &str, x: f64) -> Result<Value> {
 }
 
 /// Interleaved points, `stride` numbers each: a `Float32Array` (copied once
-/// into wasm memory), or a `Float64Array` or `Array` of numbers (converted
-/// to f32). More than [`MAX_POINTS`] points are refused before anything is
-/// allocated.
-pub(crate) fn points_of(v: &JsValue, stride: Stride) -> WasmResult<Vec<f32>> {
+/// into wasm memory) stays f32; a `Float64Array` or `Array` of numbers stays
+/// f64, re-centred in f64 by the core before anything becomes f32 (map
+/// coordinates). More than [`MAX_POINTS`] points are refused before anything
+/// is allocated.
+pub(crate) fn points_of(v: &JsValue, stride: Stride) -> WasmResult<Coordinates> {
     // A length that is no multiple of the stride is refused before the copy.
     let whole = |len: usize| {
         if len % stride == 0 {
@@ -517,7 +518,14 @@ pub(crate) fn points_of(v: &JsValue, stride: Stride) -> WasmResult<Vec<f32>> {
             Err(Error::BadLength { len, stride })
         }
     };
-    match numbers_of::<f32>(v, "points", MAX_POINTS.saturating_mul(stride), &whole) {
+    let max = MAX_POINTS.saturating_mul(stride);
+    let read = match js::typed_array(v) {
+        Some((tag, _)) if tag == "Float32Array" => {
+            numbers_of::<f32>(v, "points", max, &whole).map(Coordinates::F32)
+        }
+        _ => numbers_of::<f64>(v, "points", max, &whole).map(Coordinates::F64),
+    };
+    match read {
         Ok(values) => Ok(values),
         Err(NumbersError::Failed(f)) => Err(f),
         Err(NumbersError::NotNumber(i, x)) => Err(invalid(format!(

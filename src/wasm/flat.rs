@@ -5,7 +5,6 @@
 use super::convert::{points_of, set, DetectOptions};
 use super::error::WasmResult;
 use super::scenario::JsScenario;
-use crate::cloud::Cloud;
 use crate::flat::{flatten, FlatPolygons};
 use crate::primitive::Primitive;
 use js_sys::{Float64Array, Object, Uint32Array, Uint8Array};
@@ -83,7 +82,7 @@ pub fn detect_flat(
 ) -> WasmResult<Object> {
     let options = DetectOptions::from_js(&options.unwrap_or(JsValue::UNDEFINED))?;
     let values = points_of(&points, options.stride)?;
-    let cloud = Cloud::from_flat(&values, options.stride)?;
+    let cloud = values.cloud(options.stride)?;
     let found = crate::detect::detect(&cloud, &options.params)?;
     Ok(flat_object(&found.primitives))
 }

@@ -37,7 +37,6 @@ pub use scenario::JsScenario;
 pub use sim::{simulate, JsSimulation, ScanIterator};
 
 use crate::clock;
-use crate::cloud::Cloud;
 use crate::params::Params;
 use convert::{points_of, polygons_array, to_js, DetectOptions};
 use js_sys::{Array, Function, Reflect};
@@ -123,7 +122,9 @@ const TS_PIPELINE_OPTIONS: &'static str =
 /// Algorithm 1).
 ///
 /// `points`: interleaved x, y, z[, intensity] (`options.stride`, default 3)
-/// in metres, a `Float32Array` (copied once). `options`: the pipeline
+/// in metres, a `Float32Array` (copied once; coordinates within 1e5 m of
+/// the origin) or a `Float64Array` (kept in f64 and re-centred: map
+/// coordinates). `options`: the pipeline
 /// options (`DetectOptions`); `viewpoint` is the sensor position (default
 /// the origin: a scan in its own sensor frame).
 ///
@@ -138,7 +139,7 @@ pub fn detect(
 ) -> WasmResult<Array> {
     let options = DetectOptions::from_js(&options.unwrap_or(JsValue::UNDEFINED))?;
     let values = points_of(&points, options.stride)?;
-    let cloud = Cloud::from_flat(&values, options.stride)?;
+    let cloud = values.cloud(options.stride)?;
     let found = crate::detect::detect(&cloud, &options.params)?;
     Ok(polygons_array(&found.primitives))
 }

@@ -7,7 +7,6 @@
 
 use super::convert::{points_of, polygons_array, DetectOptions};
 use super::error::{Failure, WasmResult};
-use crate::cloud::Cloud;
 use crate::detect::{detect_with_progress, Progress};
 use js_sys::{Array, Function, Object, Reflect};
 use std::ops::ControlFlow;
@@ -34,7 +33,7 @@ pub fn detect_with_progress_js(
     }
     let options = DetectOptions::from_js(&options)?;
     let values = points_of(&points, options.stride)?;
-    let cloud = Cloud::from_flat(&values, options.stride)?;
+    let cloud = values.cloud(options.stride)?;
     let mut thrown: Option<JsValue> = None;
     let mut last = 0;
     let mut report = |at: &Progress| {

@@ -5,6 +5,7 @@ use super::convert::{
 };
 use super::error::{invalid, Failure, WasmResult};
 use super::js::{self, describe};
+use crate::cloud::Coordinates;
 use crate::mesh;
 use crate::scenario::{Scenario, MAX_SNAPSHOT_BYTES};
 use js_sys::{Array, JsString, Object, Uint32Array};
@@ -82,7 +83,9 @@ impl JsScenario {
     /// Add a scan and update the map.
     ///
     /// `points`: interleaved x, y, z[, intensity] in the sensor frame
-    /// (metres), a `Float32Array` (copied once). `options.stride`: 3 or 4
+    /// (metres), a `Float32Array` (copied once; within 1e5 m of the sensor)
+    /// or a `Float64Array` (kept in f64: map coordinates, e.g. with the
+    /// identity pose). `options.stride`: 3 or 4
     /// (default 3). `options.pose`: world-from-sensor rigid transform, 16
     /// numbers column-major (three.js `Matrix4.elements` order, or a
     /// `Matrix4`), identity when omitted.
@@ -100,9 +103,11 @@ impl JsScenario {
     ) -> WasmResult<JsValue> {
         let options = ScanOptions::from_js(&options.unwrap_or(JsValue::UNDEFINED))?;
         let values = points_of(&points, options.stride)?;
-        let report = self
-            .get_mut()?
-            .add_scan(&values, options.stride, &options.pose)?;
+        let mut scenario = self.get_mut()?;
+        let report = match &values {
+            Coordinates::F32(v) => scenario.add_scan(v, options.stride, &options.pose)?,
+            Coordinates::F64(v) => scenario.add_scan_f64(v, options.stride, &options.pose)?,
+        };
         to_js(&report)
     }
 

@@ -10,7 +10,6 @@
 //! [`Params::from_options`], the parser (and error messages) of the JS
 //! options.
 
-use crate::cloud::Cloud;
 use crate::error::{Error, Result};
 use crate::params::Params;
 use crate::primitive::Primitive;
@@ -38,9 +37,12 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Cmd {
-    /// One-shot detection of a world-frame cloud (little-endian f32; stride 4 = KITTI .bin)
+    /// One-shot detection of a world-frame cloud (LAS/LAZ, PCD, PLY, or raw
+    /// float32 with --stride)
     Detect(DetectArgs),
-    /// Incremental scenario over DIR/NNNNNN.bin (sensor frame) with DIR/poses.txt (KITTI)
+    /// Incremental scenario over a KITTI sequence (velodyne/NNNNNN.bin,
+    /// camera poses and calib.txt) or DIR/NNNNNN.bin with DIR/poses.txt
+    /// (LiDAR poses, as `simulate` writes)
     Replay(ReplayArgs),
     /// Write a simulated HDL-64E drive with labels and ground truth
     Simulate(SimulateArgs),
@@ -53,17 +55,25 @@ enum Cmd {
 
 #[derive(Args)]
 struct DetectArgs {
-    /// The cloud: little-endian f32 values, `--stride` of them per point
-    #[arg(value_name = "CLOUD.bin")]
+    /// The cloud, world frame: LAS/LAZ, PCD or PLY (told by the header;
+    /// coordinates kept in f64 where the file has them), or headerless
+    /// little-endian float32 with --stride
+    #[arg(value_name = "CLOUD")]
     cloud: String,
-    /// Values per point: 3 (x, y, z) or 4 (x, y, z, intensity)
-    #[arg(long, value_name = "3|4", default_value_t = 4)]
-    stride: usize,
-    /// KITTI poses (12 numbers a line, world-from-sensor) of the scans the
-    /// cloud was accumulated from: the viewpoint is their mean position
+    /// Values per point of a headerless float32 file: 4 (x, y, z,
+    /// intensity: KITTI .bin) or 3 (x, y, z). No default: a wrong guess
+    /// reads plausible nonsense
+    #[arg(long, value_name = "3|4")]
+    stride: Option<usize>,
+    /// Poses (12 numbers a line, world-from-LiDAR) of the scans the cloud
+    /// was accumulated from: the viewpoint is their mean position
     /// (conflicts with --viewpoint)
     #[arg(long, value_name = "poses.txt", conflicts_with = "viewpoint")]
     poses: Option<String>,
+    /// KITTI calibration: --poses are KITTI camera-0 poses, converted to
+    /// LiDAR poses with its Tr (Tr^-1 . P . Tr)
+    #[arg(long, value_name = "calib.txt", requires = "poses")]
+    calib: Option<String>,
     #[command(flatten)]
     pipeline: PipelineArgs,
     /// Write the polygons (JSON) to FILE instead of stdout
@@ -73,9 +83,34 @@ struct DetectArgs {
 
 #[derive(Args)]
 struct ReplayArgs {
-    /// The dataset: NNNNNN.bin scans (sensor frame, stride 4) and poses.txt
+    /// The scans: a KITTI sequence (SEQ/velodyne/NNNNNN.bin, poses
+    /// SEQ/poses.txt or ROOT/poses/NN.txt, SEQ/calib.txt), a KITTI dataset
+    /// root with --sequence, or a flat DIR/NNNNNN.bin with DIR/poses.txt of
+    /// world-from-LiDAR poses. Scans are stride-4 float32 (x, y, z,
+    /// intensity) in the LiDAR frame; scan k goes with pose line k
     #[arg(value_name = "DIR")]
     dir: String,
+    /// The sequence (e.g. 00) when DIR is a KITTI dataset root
+    #[arg(long, value_name = "ID")]
+    sequence: Option<String>,
+    /// The poses file, instead of the layout's
+    #[arg(long, value_name = "FILE")]
+    poses: Option<String>,
+    /// KITTI calibration (found as SEQ/calib.txt in KITTI's layout): the
+    /// poses are camera-0 poses, converted to LiDAR poses with its Tr
+    #[arg(long, value_name = "calib.txt", conflicts_with = "lidar_poses")]
+    calib: Option<String>,
+    /// The poses are world-from-LiDAR already (no calibration, no
+    /// conversion), also in KITTI's layout
+    #[arg(long)]
+    lidar_poses: bool,
+    /// Replay the scans that are there when scan numbers are missing (each
+    /// with the pose of its number) instead of refusing the sequence
+    #[arg(long)]
+    skip_missing: bool,
+    /// Leave out empty (0-byte) scans instead of refusing the sequence
+    #[arg(long)]
+    skip_empty: bool,
     #[command(flatten)]
     pipeline: PipelineArgs,
     /// Write the polygons (JSON) to FILE instead of stdout
@@ -128,13 +163,14 @@ struct OnDataArgs {
     /// Polygons to measure: a JSON document as `detect` and `replay` write
     #[arg(value_name = "PRED.json")]
     pred: String,
-    /// The cloud they were made from, in the same frame: little-endian f32
-    /// values, `--stride` of them per point
-    #[arg(value_name = "CLOUD.bin")]
+    /// The cloud they were made from, in the same frame: LAS/LAZ, PCD, PLY,
+    /// or headerless little-endian float32 with --stride
+    #[arg(value_name = "CLOUD")]
     cloud: String,
-    /// Values per point: 3 (x, y, z) or 4 (x, y, z, intensity)
-    #[arg(long, value_name = "3|4", default_value_t = 4)]
-    stride: usize,
+    /// Values per point of a headerless float32 file: 4 (x, y, z,
+    /// intensity: KITTI .bin) or 3 (x, y, z); no default
+    #[arg(long, value_name = "3|4")]
+    stride: Option<usize>,
     /// Distance (m) from a polygon's sample to the nearest point that still
     /// counts as on the data
     #[arg(long, value_name = "M", default_value_t = 0.2)]
@@ -353,20 +389,55 @@ fn write_or_return(doc: &impl Serialize, out: Option<String>) -> Result<String> 
     }
 }
 
+/// The points of a cloud file ([`crate::io::read_points`]); `--stride` is
+/// for headerless files only.
+fn read_cloud(path: &str, stride: Option<usize>) -> Result<crate::io::PointFile> {
+    let file = crate::io::read_points(Path::new(path), stride)?;
+    if let (Some(s), false) = (stride, file.format == crate::io::Format::Raw) {
+        return Err(Error::Invalid(format!(
+            "{path}: a {} file, which says what its points hold: --stride {s} is for \
+             headerless float32 files only",
+            file.format.name()
+        )));
+    }
+    Ok(file)
+}
+
+/// `error` about the points of `path`, with the file named.
+fn in_file(path: &str, error: Error) -> Error {
+    match error {
+        Error::Io(m) if m.contains(path) => Error::Io(m),
+        other => Error::Io(format!("{path}: {other}")),
+    }
+}
+
+/// Poses of a file, as world-from-LiDAR: KITTI camera poses converted with
+/// the `calib` file's Tr when one is given.
+fn read_lidar_poses(path: &str, calib: Option<&str>) -> Result<Vec<glam::DMat4>> {
+    let text =
+        std::fs::read_to_string(path).map_err(|e| Error::Io(format!("cannot read {path}: {e}")))?;
+    let poses = crate::io::parse_poses(&text).map_err(|e| match e {
+        Error::BadPose(m) => Error::BadPose(format!("{path}: {m}")),
+        other => other,
+    })?;
+    let Some(calib) = calib else {
+        return Ok(poses);
+    };
+    let text = std::fs::read_to_string(calib)
+        .map_err(|e| Error::Io(format!("cannot read {calib}: {e}")))?;
+    let tr = crate::io::kitti::parse_calib(&text).map_err(|e| in_file(calib, e))?;
+    Ok(crate::io::kitti::lidar_poses(&poses, &tr))
+}
+
 fn detect_cmd(args: DetectArgs, mut params: Params) -> Result<String> {
     if let Some(path) = &args.poses {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| Error::Io(format!("cannot read {path}: {e}")))?;
-        let poses = crate::io::parse_poses(&text).map_err(|e| match e {
-            Error::BadPose(m) => Error::BadPose(format!("{path}: {m}")),
-            other => other,
-        })?;
+        let poses = read_lidar_poses(path, args.calib.as_deref())?;
         let mean = crate::io::mean_position(&poses)
             .ok_or_else(|| Error::BadPose(format!("{path}: no poses")))?;
         params.viewpoint = Some(mean.to_array());
     }
-    let values = crate::io::read_bin(Path::new(&args.cloud), args.stride)?;
-    let cloud = Cloud::from_flat(&values, args.stride)?;
+    let file = read_cloud(&args.cloud, args.stride)?;
+    let cloud = file.cloud().map_err(|e| in_file(&args.cloud, e))?;
     let found = crate::detect::detect(&cloud, &params)?;
     let doc = PolygonsJson {
         polygons: found.primitives.iter().map(PolygonJson::from).collect(),
@@ -376,12 +447,29 @@ fn detect_cmd(args: DetectArgs, mut params: Params) -> Result<String> {
 }
 
 fn replay_cmd(args: ReplayArgs, params: Params) -> Result<String> {
-    let data = crate::sim::read_dataset(Path::new(&args.dir))?;
+    use crate::cloud::Coordinates;
+    let options = crate::io::kitti::SequenceOptions {
+        sequence: args.sequence,
+        poses: args.poses.map(Into::into),
+        calib: args.calib.map(Into::into),
+        lidar_poses: args.lidar_poses,
+        skip_missing: args.skip_missing,
+        skip_empty: args.skip_empty,
+    };
+    let seq = crate::io::kitti::Sequence::open(Path::new(&args.dir), &options)?;
     let mut scenario = crate::scenario::Scenario::new(params)?;
     let mut lines = String::new();
     let mut total_ms = 0.0;
-    for (scan, pose) in data.scans.iter().zip(&data.poses) {
-        let report = scenario.add_scan(&scan.points, 4, pose)?;
+    for (scan, pose) in seq.scans.iter().zip(&seq.poses) {
+        // KITTI's .bin is stride 4; a file with a header is read as its
+        // format, never as raw values.
+        let file = crate::io::read_points(&scan.path, Some(4))?;
+        let name = scan.path.display().to_string();
+        let report = match &file.coordinates {
+            Coordinates::F32(v) => scenario.add_scan(v, file.stride, pose),
+            Coordinates::F64(v) => scenario.add_scan_f64(v, file.stride, pose),
+        }
+        .map_err(|e| in_file(&name, e))?;
         total_ms += report.time_ms.total;
         lines.push_str(&serde_json::to_string(&report).map_err(|e| Error::Invalid(e.to_string()))?);
         lines.push('\n');
@@ -521,11 +609,7 @@ fn ondata_cmd(args: OnDataArgs) -> Result<String> {
         )));
     }
     let pred = read_pred(&args.pred)?;
-    let values = crate::io::read_bin(Path::new(&args.cloud), args.stride)?;
-    let points: Vec<glam::DVec3> = values
-        .chunks_exact(args.stride)
-        .map(|p| glam::DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64))
-        .collect();
+    let points = read_cloud(&args.cloud, args.stride)?.world_points();
     let polygons: Vec<crate::geometry::Polygon3> = pred.iter().map(|p| p.1.clone()).collect();
     let r = crate::eval::on_data(&polygons, &points, args.radius);
     let doc = OnDataJson {

@@ -1,11 +1,30 @@
 //! Reading and writing the on-disk formats: KITTI-style `.bin` scans
 //! (little-endian f32, stride 3 or 4), per-point `.label` files (little-endian
-//! u32) and KITTI odometry `poses.txt` (12 numbers per line: the row-major top
-//! three rows of a 4x4 world-from-sensor transform).
+//! u32), KITTI odometry `poses.txt` (12 numbers per line: the row-major top
+//! three rows of a 4x4 world-from-sensor transform) and KITTI sequences with
+//! their calibration ([`kitti`]).
+//!
+//! Natively, [`read_points`] reads a point file of any format the command
+//! line takes: LAS/LAZ (`las`), PCD (`pcd-rs`), PLY (`ply-rs-bw`), told by
+//! its header ([`Format::sniff`]), or headerless little-endian float32 with
+//! a stride the caller gives. These readers are not in the wasm build.
 
 use crate::error::{Error, Result};
 use glam::{DMat4, DVec3, DVec4};
 use std::path::Path;
+
+pub mod kitti;
+#[cfg(not(target_arch = "wasm32"))]
+mod las;
+#[cfg(not(target_arch = "wasm32"))]
+mod pcd;
+#[cfg(not(target_arch = "wasm32"))]
+mod ply;
+#[cfg(not(target_arch = "wasm32"))]
+mod points;
+
+#[cfg(not(target_arch = "wasm32"))]
+pub use points::{read_points, Format, PointFile};
 
 /// Decode little-endian f32s; `stride` numbers per point. Errors on a length
 /// that is not a whole number of points and on NaN or infinite coordinates.
