@@ -95,22 +95,30 @@ impl Coordinates {
     }
 }
 
-/// The first point of float32 input with a coordinate beyond
-/// [`MAX_F32_COORDINATE`], as an error; called only when the largest
-/// coordinate is beyond it (and within [`MAX_COORDINATE`]).
-fn f32_precision_error(values: &[f32], stride: usize) -> Error {
+/// Float32 input with a coordinate beyond [`MAX_F32_COORDINATE`] (called
+/// only when the largest is beyond it): [`Error::F32Precision`] for the
+/// first such point that belongs to the bulk of the cloud. Far outliers
+/// (see [`bulk_extent`]) are no error: detection leaves them out, so their
+/// rounding cannot make planes, and one stray return must not refuse a scan.
+fn check_f32_precision(values: &[f32], stride: usize) -> Result<()> {
     let limit = MAX_F32_COORDINATE as f32;
+    let at = |p: &[f32]| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
+    let bulk = bulk_extent(values.chunks_exact(stride).map(at));
+    let in_bulk = |w: DVec3| match bulk {
+        None => true,
+        Some((median, reach)) => (w - median).abs().max_element() <= reach,
+    };
     for (i, p) in values.chunks_exact(stride).enumerate() {
         let m = p[0].abs().max(p[1].abs()).max(p[2].abs());
-        if m > limit {
-            return Error::F32Precision {
+        if m > limit && in_bulk(at(p)) {
+            return Err(Error::F32Precision {
                 point: i,
                 value: m as f64,
                 limit: MAX_F32_COORDINATE,
-            };
+            });
         }
     }
-    Error::Invalid("float32 coordinates beyond the precision limit".into())
+    Ok(())
 }
 
 /// The first point whose world coordinates lie beyond [`MAX_COORDINATE`].
@@ -215,7 +223,8 @@ impl Cloud {
 
     /// From a flat f32 buffer (stride 3 or 4), world frame. Coordinates must
     /// lie within [`MAX_F32_COORDINATE`]: farther points are an
-    /// [`Error::F32Precision`] (pass them in f64, [`Cloud::from_flat_f64`]).
+    /// [`Error::F32Precision`] (pass them in f64, [`Cloud::from_flat_f64`]),
+    /// unless they are a few far outliers (see [`bulk_extent`]).
     pub fn from_flat(values: &[f32], stride: usize) -> Result<Self> {
         let largest = check_finite(values, stride)?;
         let at = |p: &[f32]| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
@@ -223,7 +232,7 @@ impl Cloud {
             check_range(values.chunks_exact(stride).map(at))?;
         }
         if largest as f64 > MAX_F32_COORDINATE {
-            return Err(f32_precision_error(values, stride));
+            check_f32_precision(values, stride)?;
         }
         Ok(Self::around_box_centre(values.chunks_exact(stride).map(at)))
     }
@@ -280,7 +289,7 @@ impl Cloud {
             points.push((w - origin).as_vec3());
         }
         if largest as f64 > MAX_F32_COORDINATE {
-            return Err(f32_precision_error(values, stride));
+            check_f32_precision(values, stride)?;
         }
         Ok(Cloud { origin, points })
     }
