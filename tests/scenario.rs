@@ -387,8 +387,10 @@ fn memory_is_bounded_by_the_mapped_area_not_the_scans() {
     };
     let mut sizes = Vec::new();
     let mut support = Vec::new();
+    let mut pool = Vec::new();
     for _ in 0..60 {
-        s.add_scan(&scan.points, 4, &scan.pose).unwrap();
+        let r = s.add_scan(&scan.points, 4, &scan.pose).unwrap();
+        pool.push(r.pool_points);
         sizes.push(size(&s));
         support.push(s.primitives().iter().map(|q| q.support).sum::<u64>());
     }
@@ -406,6 +408,10 @@ fn memory_is_bounded_by_the_mapped_area_not_the_scans() {
         support[59] > 2 * support[19],
         "support should keep counting"
     );
+    // The pool of unexplained points holds one point a voxel of what no
+    // primitive explains: the same place seen again does not grow it.
+    assert!(pool[19] > 0 && pool[19] <= s.params().pool_max_points);
+    assert!(pool[59] * 10 <= pool[19] * 11, "pool {} -> {}", pool[19], pool[59]);
     // Outlines stay within the vertex budget.
     assert!(s
         .primitives()
