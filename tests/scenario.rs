@@ -411,7 +411,12 @@ fn memory_is_bounded_by_the_mapped_area_not_the_scans() {
     // The pool of unexplained points holds one point a voxel of what no
     // primitive explains: the same place seen again does not grow it.
     assert!(pool[19] > 0 && pool[19] <= s.params().pool_max_points);
-    assert!(pool[59] * 10 <= pool[19] * 11, "pool {} -> {}", pool[19], pool[59]);
+    assert!(
+        pool[59] * 10 <= pool[19] * 11,
+        "pool {} -> {}",
+        pool[19],
+        pool[59]
+    );
     // Outlines stay within the vertex budget.
     assert!(s
         .primitives()

@@ -68,7 +68,7 @@ pub(crate) struct Selection {
 /// Millimetres of an origin (whole metres for every cloud the scenario
 /// makes).
 fn origin_mm(origin: DVec3) -> [i64; 3] {
-    origin.to_array().map(|v| mm(v))
+    origin.to_array().map(mm)
 }
 
 impl Pool {
