@@ -127,6 +127,12 @@ pub struct Params {
     pub merge_distance: f64,
     /// `mergeGap` (m).
     pub merge_gap: f64,
+    /// `poolScans` (scans; 0: no pool).
+    pub pool_scans: usize,
+    /// `poolVoxel` (m).
+    pub pool_voxel: f64,
+    /// `poolMaxPoints`.
+    pub pool_max_points: usize,
 }
 
 impl Check {
@@ -254,6 +260,9 @@ impl Params {
             merge_angle: 8.0,
             merge_distance: 0.08,
             merge_gap: 0.3,
+            pool_scans: 10,
+            pool_voxel: 0.1,
+            pool_max_points: 100_000,
         }
     }
 

@@ -140,4 +140,19 @@ options! {
     /// Outlines closer than this are touching, for a merge (m). Default
     /// 0.3.
     merge_gap: f64 = merge_gap, "m", Check::Between(0.0, 100.0);
+    /// The scenario keeps the points no primitive explained for this many
+    /// scans (the pool), and each scan's detection sees them beside its
+    /// own leftovers, so a surface that comes into view a little in each
+    /// scan (a far facade, the end of a car, a curb, a ramp at grazing
+    /// range) is found once its points add up. 0 turns the pool off (each
+    /// scan's detection sees its own leftovers, as in the paper). Default
+    /// 10.
+    pool_scans: usize = pool_scans, "scans", Check::Count(0, 10_000);
+    /// Voxel side of the pool (m): it keeps one point a voxel, the newest,
+    /// in a grid anchored at the world origin. Default 0.1.
+    pool_voxel: f64 = pool_voxel, "m", Check::Between(0.01, 10.0);
+    /// Most points the pool holds; the oldest go first. Bounds its memory
+    /// (32 bytes a point) and the detection time it adds; 0 turns the pool
+    /// off. Default 100000.
+    pool_max_points: usize = pool_max_points, "", Check::Count(0, 100_000_000);
 }

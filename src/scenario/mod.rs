@@ -7,6 +7,7 @@
 
 mod expand;
 mod index;
+mod pool;
 pub mod snapshot;
 pub use crate::merge::MergeEvent;
 
@@ -20,6 +21,7 @@ use crate::primitive::Primitive;
 use crate::rng::Rng;
 use glam::{DMat4, DVec3};
 use index::ScanIndex;
+use pool::Pool;
 use serde::{Deserialize, Serialize};
 
 /// Longest snapshot text [`Scenario::from_json`] reads (bytes; 256 MiB):
@@ -58,6 +60,14 @@ pub struct ScanReport {
     /// Of those, points taken by the primitives detection added (the others
     /// stay unexplained: clutter, vegetation, too-small surfaces).
     pub explained_by_detection: usize,
+    /// Points of the pool (earlier scans' unexplained points, one a voxel)
+    /// that detection saw beside this scan's.
+    pub pool_to_detection: usize,
+    /// Pool points explained this scan (taken by expansion or by a new
+    /// primitive).
+    pub explained_from_pool: usize,
+    /// Points in the pool after the scan.
+    pub pool_points: usize,
     /// Ids of new primitives.
     pub added: Vec<u32>,
     /// Ids of existing primitives that grew.
@@ -83,6 +93,9 @@ pub struct Scenario {
     primitives: Vec<Primitive>,
     next_id: u32,
     scans: u64,
+    /// Unexplained points of the last scans (`poolScans`), world frame.
+    #[serde(default)]
+    pool: Pool,
     #[serde(skip)]
     last_labels: Vec<u32>,
     /// Where the primitives are (derived, rebuilt after a restore).
@@ -99,6 +112,7 @@ impl Scenario {
             primitives: Vec::new(),
             next_id: 0,
             scans: 0,
+            pool: Pool::default(),
             last_labels: Vec::new(),
             index: PrimIndex::default(),
         })
@@ -157,12 +171,23 @@ impl Scenario {
     /// Add a scan already in the world frame (`cloud`), seen from `sensor`
     /// (world position, used to orient new normals). `t0` is the clock
     /// reading the total time counts from.
-    pub fn add_cloud(&mut self, cloud: &Cloud, sensor: DVec3, t0: f64) -> ScanReport {
+    pub fn add_cloud(&mut self, scan_cloud: &Cloud, sensor: DVec3, t0: f64) -> ScanReport {
         let p = &self.params;
         let scan = self.scans;
-        let n = cloud.len();
-        let mut labels = vec![NO_PRIMITIVE; n];
-        let mut alive = vec![true; n];
+        let n = scan_cloud.len();
+        // The scan's points, then the pool's: expansion and detection see
+        // both, the report and the labels count the scan's.
+        // An empty scan brings no evidence: it changes nothing (the pool's
+        // points only grow older).
+        let joined = if n > 0 {
+            self.pool.join(scan_cloud)
+        } else {
+            None
+        };
+        let cloud = joined.as_ref().unwrap_or(scan_cloud);
+        let all = cloud.len();
+        let mut labels = vec![NO_PRIMITIVE; all];
+        let mut alive = vec![true; all];
         let mut report = ScanReport {
             scan,
             points: n,
@@ -174,7 +199,7 @@ impl Scenario {
         if p.expansion {
             self.index.ensure(&self.primitives, p);
         }
-        if p.expansion && !self.primitives.is_empty() && n > 0 {
+        if p.expansion && !self.primitives.is_empty() && all > 0 {
             let mut index = ScanIndex::new(&cloud.points, INDEX_VOXEL);
             let mut scratch = expand::Scratch::default();
             // Only the primitives a point of this scan could reach (exact:
@@ -199,16 +224,19 @@ impl Scenario {
                 if taken > 0 {
                     self.index.update(prim);
                     report.grown.push(prim.id);
-                    report.explained_by_expansion += taken;
                 }
             }
+            report.explained_by_expansion = alive[..n].iter().filter(|&&a| !a).count();
         }
         report.time_ms.expansion = clock::now_ms() - te;
 
         // 2. Detection on the leftover points.
         let td = clock::now_ms();
-        let rest: Vec<u32> = (0..n as u32).filter(|&i| alive[i as usize]).collect();
-        report.sent_to_detection = rest.len();
+        let selection = self.pool.select(cloud, n, &alive, p);
+        let empty = n == 0;
+        let rest = &selection.rest;
+        report.sent_to_detection = selection.from_scan;
+        report.pool_to_detection = rest.len() - selection.from_scan;
         let pts: Vec<glam::Vec3> = rest.iter().map(|&i| cloud.points[i as usize]).collect();
         let det = Detector::new(p, CascadePolicy::scenario_leftovers()).run_with_rng(
             &pts,
@@ -224,14 +252,22 @@ impl Scenario {
             prim.last_scan = scan;
             for (k, &l) in det.labels.iter().enumerate() {
                 if l == local {
-                    labels[rest[k] as usize] = prim.id;
-                    report.explained_by_detection += 1;
+                    let i = rest[k] as usize;
+                    labels[i] = prim.id;
+                    alive[i] = false;
+                    report.explained_by_detection += usize::from(i < n);
                 }
             }
             report.added.push(prim.id);
             self.index.update(&prim);
             self.primitives.push(prim);
         }
+        report.explained_from_pool = alive[n..].iter().filter(|&&a| !a).count();
+        if !empty {
+            self.pool.carry(cloud, n, &alive, &selection, scan, p);
+        }
+        report.pool_points = self.pool.len();
+        labels.truncate(n);
         report.time_ms.detection = clock::now_ms() - td;
 
         // 3. Merge primitives that now touch (never in the paper's mode
@@ -284,6 +320,7 @@ impl Scenario {
         s.params.validate()?;
         snapshot::check(&s.primitives, s.next_id, s.scans, &s.params)
             .map_err(|e| Error::Invalid(format!("not a polyscene snapshot: {e}")))?;
+        s.pool.validate(s.scans)?;
         Ok(s)
     }
 }

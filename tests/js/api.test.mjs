@@ -9,7 +9,7 @@ import { ps, repoRoot } from "./common.mjs";
 import { optionDocs, documentedDefault, sameValue, optionsTable } from "../../scripts/gen-js-docs.mjs";
 
 const POLYGON_KEYS = ["id", "normal", "offset", "vertices", "area", "support", "density", "ground", "bornScan", "lastScan"];
-const REPORT_KEYS = ["scan", "points", "explainedByExpansion", "sentToDetection", "explainedByDetection", "added", "grown", "merged", "polygonCount", "totalArea", "timeMs"];
+const REPORT_KEYS = ["scan", "points", "explainedByExpansion", "sentToDetection", "explainedByDetection", "poolToDetection", "explainedFromPool", "poolPoints", "added", "grown", "merged", "polygonCount", "totalArea", "timeMs"];
 
 test("exports", () => {
   for (const name of ["Scenario", "Simulation", "ScanIterator", "detect", "simulate", "defaultOptions", "version"]) {
@@ -35,6 +35,9 @@ test("reports, polygons and labels of a street drive", () => {
     assert.equal(report.points, points.length / 4);
     assert.equal(report.explainedByExpansion + report.sentToDetection, report.points);
     assert.ok(report.explainedByDetection <= report.sentToDetection);
+    // The pool holds earlier scans' unexplained points: none at the first scan.
+    if (k === 0) assert.equal(report.poolToDetection + report.explainedFromPool, 0);
+    assert.ok(report.poolPoints > 0 && report.poolPoints <= 100000);
     for (const m of report.merged) assert.deepEqual(Object.keys(m), ["kept", "removed"]);
     const labels = scenario.lastLabels();
     assert.ok(labels instanceof Uint32Array);
