@@ -264,7 +264,10 @@ impl Scenario {
         }
         report.explained_from_pool = alive[n..].iter().filter(|&&a| !a).count();
         if !empty {
-            self.pool.carry(cloud, n, &alive, &selection, scan, p);
+            let (index, prims) = (&self.index, &self.primitives);
+            let known = |w: DVec3| near_known_surface(index, prims, p, w);
+            self.pool
+                .carry(cloud, n, &alive, &selection, scan, p, &known);
         }
         report.pool_points = self.pool.len();
         labels.truncate(n);
@@ -323,4 +326,23 @@ impl Scenario {
         s.pool.validate(s.scans)?;
         Ok(s)
     }
+}
+
+/// Is world point `w` on a known polygon seen through an imperfect pose:
+/// inside its outline and within two expansion gates (`expandAcross`) of its
+/// plane? Expansion takes points within one gate; a pose a few centimetres
+/// or a tenth of a degree off puts a known surface's points just beyond it.
+/// Left in the pool, such points would add up, scan after scan, to a second
+/// layer of the same surface; so the pool does not keep them (the scan's
+/// detection still sees them, as without a pool).
+fn near_known_surface(index: &PrimIndex, prims: &[Primitive], params: &Params, w: DVec3) -> bool {
+    index.at_point(w).any(|id| {
+        let Ok(k) = prims.binary_search_by_key(&id, |q| q.id) else {
+            return false;
+        };
+        let prim = &prims[k];
+        let slack = 2.0 * params.surface(prim.ground).expand_across;
+        prim.plane.signed_distance(w).abs() <= slack
+            && crate::geometry::polygon::contains(&prim.outline, prim.frame.to_local(w))
+    })
 }

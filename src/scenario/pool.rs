@@ -153,7 +153,10 @@ impl Pool {
 
     /// The pool after scan `scan`: the scan's points still alive, one a
     /// voxel, then the pool points of `sel` still alive and younger than
-    /// `poolScans` scans, cut at `poolMaxPoints`.
+    /// `poolScans` scans, cut at `poolMaxPoints`. A point for which `known`
+    /// is true (it lies on a known polygon, a little off its plane) is not
+    /// kept (see `near_known_surface` in the scenario).
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn carry(
         &mut self,
         cloud: &Cloud,
@@ -162,6 +165,7 @@ impl Pool {
         sel: &Selection,
         scan: u64,
         params: &Params,
+        known: &dyn Fn(DVec3) -> bool,
     ) {
         let (age, cap) = (params.pool_scans as u64, params.pool_max_points);
         let anchor = origin_mm(cloud.origin);
@@ -174,7 +178,7 @@ impl Pool {
                     break;
                 }
                 let v = sel.voxel_of[j] as usize;
-                if alive[i as usize] && !kept[v] {
+                if alive[i as usize] && !kept[v] && !known(cloud.world(i as usize)) {
                     kept[v] = true;
                     let w = sel.scan_mm[j];
                     mm.extend((0..3).map(|a| w[a] - anchor[a]));
@@ -186,7 +190,7 @@ impl Pool {
                 if seen.len() >= cap {
                     break;
                 }
-                if alive[i] && scan.saturating_sub(self.seen[k]) < age {
+                if alive[i] && scan.saturating_sub(self.seen[k]) < age && !known(cloud.world(i)) {
                     let w = self.world_mm(k);
                     mm.extend((0..3).map(|a| w[a] - anchor[a]));
                     seen.push(self.seen[k]);
