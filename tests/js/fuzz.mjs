@@ -210,6 +210,13 @@ function actions(base) {
   const none = fc.constant([]);
   return fc.oneof(
     on("detect", 6, fc.tuple(points, options), (ctx, p, o) => ps.detect(p, o)),
+    on("detectFlat", 2, fc.tuple(points, options), (ctx, p, o) => ps.detectFlat(p, o)),
+    on("detectWithProgress", 2, fc.tuple(points, options, primitive), (ctx, p, o, stop) =>
+      ps.detectWithProgress(p, o, (at) => {
+        // A callback that throws what the fuzzer made, stops, or goes on.
+        if (typeof stop === "number" && at.round >= stop) throw stop;
+        return stop === false ? false : undefined;
+      })),
     on("scenario.addScan", 10, fc.tuple(points, options), (ctx, p, o) => ctx.scenario.addScan(p, o)),
     on("addScan re-entering", 1, fc.constant(maker("getter calling scenario.polygons()", () => null)), (ctx) =>
       ctx.scenario.addScan(PLANE.slice(0, 30), { get stride() { ctx.scenario.polygons(); ctx.scenario.toJSONString(); throw new Error("after re-entry"); } })),
@@ -228,7 +235,7 @@ function actions(base) {
     on("simulation.scan", 2, fc.oneof(primitive, hostileArray), (ctx, i) => ctx.simulation.scan(i)),
     on("getters", 1, none, (ctx) => {
       const s = ctx.scenario;
-      return [s.polygons(), s.lastLabels(), s.mesh(), s.options(), s.toJSON(), s.scans, s.polygonCount, ps.version()];
+      return [s.polygons(), s.polygonsFlat(), s.lastLabels(), s.mesh(), s.options(), s.toJSON(), s.scans, s.polygonCount, ps.version()];
     }),
   );
 }
