@@ -224,7 +224,8 @@ impl Cloud {
     /// From a flat f32 buffer (stride 3 or 4), world frame. Coordinates must
     /// lie within [`MAX_F32_COORDINATE`]: farther points are an
     /// [`Error::F32Precision`] (pass them in f64, [`Cloud::from_flat_f64`]),
-    /// unless they are a few far outliers (see [`bulk_extent`]).
+    /// unless they are a few far outliers (beyond 16 times the bulk's 10-90 %
+    /// spread and 10 km from its median), which detection leaves out.
     pub fn from_flat(values: &[f32], stride: usize) -> Result<Self> {
         let largest = check_finite(values, stride)?;
         let at = |p: &[f32]| DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
