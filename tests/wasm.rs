@@ -58,7 +58,7 @@ fn options_merge_over_the_preset() {
     );
     // No options at all: gpp2.
     let d = JsScenario::new(None).unwrap().options().unwrap();
-    let want = default_options(JsValue::UNDEFINED).unwrap();
+    let want = default_options(None).unwrap();
     assert_eq!(
         JSON::stringify(&d).unwrap().as_string(),
         JSON::stringify(&want).unwrap().as_string()

@@ -77,8 +77,8 @@ impl JsScenario {
 /// arrays (see `FlatPolygons`). Same arguments and errors as `detect`.
 #[wasm_bindgen(js_name = detectFlat, unchecked_return_type = "FlatPolygons")]
 pub fn detect_flat(
-    #[wasm_bindgen(unchecked_param_type = "Float32Array")] points: JsValue,
-    #[wasm_bindgen(unchecked_param_type = "DetectOptions")] options: Option<JsValue>,
+    #[wasm_bindgen(unchecked_param_type = "Float32Array | Float64Array")] points: JsValue,
+    #[wasm_bindgen(unchecked_optional_param_type = "DetectOptions")] options: Option<JsValue>,
 ) -> WasmResult<Object> {
     let options = DetectOptions::from_js(&options.unwrap_or(JsValue::UNDEFINED))?;
     let values = points_of(&points, options.stride)?;

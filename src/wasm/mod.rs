@@ -134,7 +134,7 @@ const TS_PIPELINE_OPTIONS: &'static str =
 /// buffer, or a bad option.
 #[wasm_bindgen(unchecked_return_type = "Polygon[]")]
 pub fn detect(
-    #[wasm_bindgen(unchecked_param_type = "Float32Array")] points: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "Float32Array | Float64Array")] points: JsValue,
     #[wasm_bindgen(unchecked_optional_param_type = "DetectOptions")] options: Option<JsValue>,
 ) -> WasmResult<Array> {
     let options = DetectOptions::from_js(&options.unwrap_or(JsValue::UNDEFINED))?;

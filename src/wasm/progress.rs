@@ -21,7 +21,7 @@ use wasm_bindgen::prelude::*;
 /// gives.
 #[wasm_bindgen(js_name = detectWithProgress, unchecked_return_type = "Polygon[]")]
 pub fn detect_with_progress_js(
-    #[wasm_bindgen(unchecked_param_type = "Float32Array")] points: JsValue,
+    #[wasm_bindgen(unchecked_param_type = "Float32Array | Float64Array")] points: JsValue,
     #[wasm_bindgen(unchecked_param_type = "DetectOptions | undefined")] options: JsValue,
     #[wasm_bindgen(unchecked_param_type = "(progress: DetectProgress) => boolean | void")]
     on_progress: Function,

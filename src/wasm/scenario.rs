@@ -98,7 +98,7 @@ impl JsScenario {
     #[wasm_bindgen(js_name = addScan, unchecked_return_type = "ScanReport")]
     pub fn add_scan(
         &self,
-        #[wasm_bindgen(unchecked_param_type = "Float32Array")] points: JsValue,
+        #[wasm_bindgen(unchecked_param_type = "Float32Array | Float64Array")] points: JsValue,
         #[wasm_bindgen(unchecked_optional_param_type = "ScanOptions")] options: Option<JsValue>,
     ) -> WasmResult<JsValue> {
         let options = ScanOptions::from_js(&options.unwrap_or(JsValue::UNDEFINED))?;
