@@ -17,7 +17,7 @@
 use super::error::{bad_option, invalid, Failure, WasmResult};
 use super::js::{self, describe};
 use crate::cloud::check_rigid;
-use crate::cloud::{Coordinates, MAX_POINTS};
+use crate::cloud::{Cloud, Coordinates, MAX_POINTS};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use crate::params::Params;
@@ -540,6 +540,15 @@ pub(crate) fn points_of(v: &JsValue, stride: Stride) -> WasmResult<Coordinates> 
         ))
         .into()),
     }
+}
+
+/// The cloud and the parameters of a one-shot detection call (`detect`,
+/// `detectFlat`, `detectWithProgress`): the options first (they give the
+/// stride), then the points, read as [`points_of`] reads them.
+pub(crate) fn detect_input(points: &JsValue, options: &JsValue) -> WasmResult<(Cloud, Params)> {
+    let options = DetectOptions::from_js(options)?;
+    let values = points_of(points, options.stride)?;
+    Ok((values.cloud(options.stride)?, options.params))
 }
 
 /// A world-from-sensor pose: 16 numbers in column-major order

@@ -2,7 +2,7 @@
 //! The core builds the columns ([`crate::flat::flatten`]); this file only
 //! copies each into a typed array.
 
-use super::convert::{points_of, set, DetectOptions};
+use super::convert::{detect_input, set};
 use super::error::WasmResult;
 use super::scenario::JsScenario;
 use crate::flat::{flatten, FlatPolygons};
@@ -80,9 +80,7 @@ pub fn detect_flat(
     #[wasm_bindgen(unchecked_param_type = "Float32Array | Float64Array")] points: JsValue,
     #[wasm_bindgen(unchecked_optional_param_type = "DetectOptions")] options: Option<JsValue>,
 ) -> WasmResult<Object> {
-    let options = DetectOptions::from_js(&options.unwrap_or(JsValue::UNDEFINED))?;
-    let values = points_of(&points, options.stride)?;
-    let cloud = values.cloud(options.stride)?;
-    let found = crate::detect::detect(&cloud, &options.params)?;
+    let (cloud, params) = detect_input(&points, &options.unwrap_or(JsValue::UNDEFINED))?;
+    let found = crate::detect::detect(&cloud, &params)?;
     Ok(flat_object(&found.primitives))
 }

@@ -38,7 +38,7 @@ pub use sim::{simulate, JsSimulation, ScanIterator};
 
 use crate::clock;
 use crate::params::Params;
-use convert::{points_of, polygons_array, to_js, DetectOptions};
+use convert::{detect_input, polygons_array, to_js};
 use js_sys::{Array, Function, Reflect};
 use std::cell::RefCell;
 use wasm_bindgen::prelude::*;
@@ -137,10 +137,8 @@ pub fn detect(
     #[wasm_bindgen(unchecked_param_type = "Float32Array | Float64Array")] points: JsValue,
     #[wasm_bindgen(unchecked_optional_param_type = "DetectOptions")] options: Option<JsValue>,
 ) -> WasmResult<Array> {
-    let options = DetectOptions::from_js(&options.unwrap_or(JsValue::UNDEFINED))?;
-    let values = points_of(&points, options.stride)?;
-    let cloud = values.cloud(options.stride)?;
-    let found = crate::detect::detect(&cloud, &options.params)?;
+    let (cloud, params) = detect_input(&points, &options.unwrap_or(JsValue::UNDEFINED))?;
+    let found = crate::detect::detect(&cloud, &params)?;
     Ok(polygons_array(&found.primitives))
 }
 

@@ -5,7 +5,7 @@
 //! stays usable), and the caller gets an `Error` with the thrown value as its
 //! `cause`, as for every other value user code throws.
 
-use super::convert::{points_of, polygons_array, DetectOptions};
+use super::convert::{detect_input, polygons_array};
 use super::error::{Failure, WasmResult};
 use crate::detect::{detect_with_progress, Progress};
 use js_sys::{Array, Function, Object, Reflect};
@@ -31,9 +31,7 @@ pub fn detect_with_progress_js(
             "detectWithProgress: onProgress must be a function",
         ));
     }
-    let options = DetectOptions::from_js(&options)?;
-    let values = points_of(&points, options.stride)?;
-    let cloud = values.cloud(options.stride)?;
+    let (cloud, params) = detect_input(&points, &options)?;
     let mut thrown: Option<JsValue> = None;
     let mut last = 0;
     let mut report = |at: &Progress| {
@@ -47,7 +45,7 @@ pub fn detect_with_progress_js(
             }
         }
     };
-    let found = detect_with_progress(&cloud, &options.params, &mut report)?;
+    let found = detect_with_progress(&cloud, &params, &mut report)?;
     if let Some(e) = thrown {
         return Err(Failure::thrown(
             &format!("detectWithProgress: onProgress after round {last}"),

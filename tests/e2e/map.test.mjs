@@ -18,6 +18,7 @@ import { mkdtempSync, mkdirSync, rmSync, writeFileSync, existsSync } from 'node:
 import os from 'node:os';
 import path from 'node:path';
 import { fileURLToPath, pathToFileURL } from 'node:url';
+import { CHROMIUM, FLAGS } from './chromium.mjs';
 
 const ROOT = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
 const WWW = path.join(ROOT, 'www');
@@ -27,18 +28,6 @@ const { chromium } = require('playwright-core');
 const { startServer } = await import(pathToFileURL(path.join(WWW, 'tools/static-server.mjs')).href);
 const ps = createRequire(import.meta.url)(path.join(ROOT, 'pkg/node'));
 
-const CHROMIUM = process.env.CHROMIUM || '/usr/bin/chromium';
-const FLAGS = [
-  '--headless',
-  '--no-sandbox',
-  '--disable-gpu',
-  '--disable-quic',
-  '--no-first-run',
-  '--disable-background-networking',
-  '--disable-component-update',
-  '--disable-sync',
-  '--enable-unsafe-swiftshader',
-];
 const VIEW = { width: 1280, height: 800 };
 
 // The frame of the test: an origin and a heading that is not 90 (x not east).

@@ -18,6 +18,7 @@ import os from 'node:os';
 import path from 'node:path';
 import { fileURLToPath, pathToFileURL } from 'node:url';
 import { decodePng } from './png.mjs';
+import { CHROMIUM, FLAGS } from './chromium.mjs';
 
 const ROOT = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
 const WWW = path.join(ROOT, 'www');
@@ -26,18 +27,6 @@ const require = createRequire(path.join(WWW, 'package.json'));
 const { chromium } = require('playwright-core');
 const { startServer } = await import(pathToFileURL(path.join(WWW, 'tools/static-server.mjs')).href);
 
-const CHROMIUM = process.env.CHROMIUM || '/usr/bin/chromium';
-const FLAGS = [
-  '--headless',
-  '--no-sandbox',
-  '--disable-gpu',
-  '--disable-quic',
-  '--no-first-run',
-  '--disable-background-networking',
-  '--disable-component-update',
-  '--disable-sync',
-  '--enable-unsafe-swiftshader',
-];
 const VIEW = { width: 1280, height: 800 };
 const BG = [0x0b, 0x0f, 0x16]; // the page's clear colour
 

@@ -21,17 +21,6 @@ import { fileURLToPath, pathToFileURL } from 'node:url';
 
 const ROOT = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
 const TOOLS = path.join(ROOT, 'tests/package/tools/node_modules/.bin');
-const CHROMIUM = process.env.CHROMIUM || '/usr/bin/chromium';
-const FLAGS = [
-  '--headless',
-  '--no-sandbox',
-  '--disable-gpu',
-  '--disable-quic',
-  '--no-first-run',
-  '--disable-background-networking',
-  '--disable-component-update',
-  '--disable-sync',
-];
 const { chromium } = createRequire(path.join(ROOT, 'www/package.json'))('playwright-core');
 const { startServer } = await import(pathToFileURL(path.join(ROOT, 'www/tools/static-server.mjs')).href);
 
@@ -317,6 +306,7 @@ export const result = { polygons: polygons.length, triangles: mesh.indices.lengt
     `${example(path.join(ROOT, 'README.md'), 'worker')}
 export const result = { polygons: summary(polygons) };
 import { summary } from "./plane.mjs";`,
+import { CHROMIUM, FLAGS } from '../e2e/chromium.mjs';
   );
 }
 
