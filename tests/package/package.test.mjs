@@ -18,6 +18,7 @@ import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { fileURLToPath, pathToFileURL } from 'node:url';
+import { CHROMIUM, FLAGS } from '../e2e/chromium.mjs';
 
 const ROOT = path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
 const TOOLS = path.join(ROOT, 'tests/package/tools/node_modules/.bin');
@@ -306,7 +307,6 @@ export const result = { polygons: polygons.length, triangles: mesh.indices.lengt
     `${example(path.join(ROOT, 'README.md'), 'worker')}
 export const result = { polygons: summary(polygons) };
 import { summary } from "./plane.mjs";`,
-import { CHROMIUM, FLAGS } from '../e2e/chromium.mjs';
   );
 }
 
