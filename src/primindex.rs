@@ -257,17 +257,6 @@ impl PrimIndex {
         self.gather(keys.into_iter())
     }
 
-    /// The primitives filed under the cell of world point `w`, and those
-    /// every query returns (unsorted, an id may repeat): every primitive
-    /// whose reach box holds `w`, among others.
-    pub fn at_point(&self, w: DVec3) -> impl Iterator<Item = u32> + '_ {
-        let cell = self
-            .cells
-            .get(&cell_of(w))
-            .map_or(&[][..], |v| v.as_slice());
-        self.big.iter().chain(cell).copied()
-    }
-
     /// Every primitive that `mergeable` could pair with `prim` (sorted
     /// ids, `prim`'s own included; a superset, never missing one). All of
     /// them when the query box is not finite or too large.

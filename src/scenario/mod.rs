@@ -196,6 +196,8 @@ impl Scenario {
 
         // 1. Expansion of existing primitives, in a cascade (id order).
         let te = clock::now_ms();
+        // The primitives a point of this scan (or of the pool) could reach.
+        let mut near: Vec<u32> = Vec::new();
         if p.expansion {
             self.index.ensure(&self.primitives, p);
         }
@@ -204,7 +206,8 @@ impl Scenario {
             let mut scratch = expand::Scratch::default();
             // Only the primitives a point of this scan could reach (exact:
             // see `primindex`), in id order.
-            for id in self.index.near_cloud(cloud) {
+            near = self.index.near_cloud(cloud);
+            for &id in &near {
                 let Ok(k) = self.primitives.binary_search_by_key(&id, |q| q.id) else {
                     continue;
                 };
@@ -264,10 +267,10 @@ impl Scenario {
         }
         report.explained_from_pool = alive[n..].iter().filter(|&&a| !a).count();
         if !empty {
-            let (index, prims) = (&self.index, &self.primitives);
-            let known = |w: DVec3| near_known_surface(index, prims, p, w);
+            near.extend_from_slice(&report.added);
+            let seen = SeenSurfaces::new(&self.primitives, &near, p);
             self.pool
-                .carry(cloud, n, &alive, &selection, scan, p, &known);
+                .carry(cloud, n, &alive, &selection, scan, p, &|w| seen.holds(w));
         }
         report.pool_points = self.pool.len();
         labels.truncate(n);
@@ -328,21 +331,87 @@ impl Scenario {
     }
 }
 
-/// Is world point `w` on a known polygon seen through an imperfect pose:
-/// inside its outline and within two expansion gates (`expandAcross`) of its
-/// plane? Expansion takes points within one gate; a pose a few centimetres
-/// or a tenth of a degree off puts a known surface's points just beyond it.
-/// Left in the pool, such points would add up, scan after scan, to a second
-/// layer of the same surface; so the pool does not keep them (the scan's
-/// detection still sees them, as without a pool).
-fn near_known_surface(index: &PrimIndex, prims: &[Primitive], params: &Params, w: DVec3) -> bool {
-    index.at_point(w).any(|id| {
-        let Ok(k) = prims.binary_search_by_key(&id, |q| q.id) else {
-            return false;
+/// Side of the cells [`SeenSurfaces`] files polygons under (m).
+const SEEN_CELL: f64 = 16.0;
+
+/// Most cells a polygon is filed under in [`SeenSurfaces`]; a larger one is
+/// tested for every point.
+const SEEN_MAX_CELLS: i64 = 4096;
+
+/// The polygons within reach of a scan (those its expansion visited, and
+/// those its detection added), filed by the cells that their outline's box,
+/// grown by the test's slack, covers: so that [`SeenSurfaces::holds`] costs
+/// what the scan saw, not what the map holds.
+struct SeenSurfaces<'a> {
+    prims: &'a [Primitive],
+    params: &'a Params,
+    cells: crate::hash::GridMap<[i64; 3], Vec<usize>>,
+    wide: Vec<usize>,
+}
+
+impl<'a> SeenSurfaces<'a> {
+    fn new(prims: &'a [Primitive], ids: &[u32], params: &'a Params) -> Self {
+        let mut seen = SeenSurfaces {
+            prims,
+            params,
+            cells: Default::default(),
+            wide: Vec::new(),
         };
-        let prim = &prims[k];
-        let slack = 2.0 * params.surface(prim.ground).expand_across;
-        prim.plane.signed_distance(w).abs() <= slack
-            && crate::geometry::polygon::contains(&prim.outline, prim.frame.to_local(w))
-    })
+        for &id in ids {
+            let Ok(k) = prims.binary_search_by_key(&id, |q| q.id) else {
+                continue;
+            };
+            let prim = &prims[k];
+            let (lo, hi) = crate::geometry::bounds(&prim.vertices());
+            let pad = DVec3::splat(seen.slack(prim));
+            let (a, b) = (seen_cell(lo - pad), seen_cell(hi + pad));
+            let count = (0..3).fold(1i64, |c, i| {
+                c.saturating_mul(b[i].saturating_sub(a[i]).saturating_add(1))
+            });
+            if !(lo.is_finite() && hi.is_finite()) || count > SEEN_MAX_CELLS {
+                seen.wide.push(k);
+                continue;
+            }
+            for x in a[0]..=b[0] {
+                for y in a[1]..=b[1] {
+                    for z in a[2]..=b[2] {
+                        seen.cells.entry([x, y, z]).or_default().push(k);
+                    }
+                }
+            }
+        }
+        seen
+    }
+
+    /// Two expansion gates (`expandAcross`) of `prim`'s kind (m).
+    fn slack(&self, prim: &Primitive) -> f64 {
+        2.0 * self.params.surface(prim.ground).expand_across
+    }
+
+    /// Is world point `w` on one of these polygons, seen through an
+    /// imperfect pose: inside its outline and within two expansion gates of
+    /// its plane? Expansion takes points within one gate; a pose a few
+    /// centimetres or a tenth of a degree off puts a surface's points just
+    /// beyond it. Left in the pool, such points would add up, scan after
+    /// scan, to a second layer of the same surface; so the pool does not
+    /// keep them (the scan's detection still sees them, as without a pool).
+    fn holds(&self, w: DVec3) -> bool {
+        let cell = self
+            .cells
+            .get(&seen_cell(w))
+            .map_or(&[][..], |v| v.as_slice());
+        self.wide.iter().chain(cell).any(|&k| {
+            let prim = &self.prims[k];
+            prim.plane.signed_distance(w).abs() <= self.slack(prim)
+                && crate::geometry::polygon::contains(&prim.outline, prim.frame.to_local(w))
+        })
+    }
+}
+
+fn seen_cell(p: DVec3) -> [i64; 3] {
+    [
+        crate::geometry::floor_i64(p.x / SEEN_CELL),
+        crate::geometry::floor_i64(p.y / SEEN_CELL),
+        crate::geometry::floor_i64(p.z / SEEN_CELL),
+    ]
 }
