@@ -1,11 +1,11 @@
 #!/usr/bin/env node
-// The README's table of JS options, generated from the built package: the
+// The table of JS options in docs/API.md, generated from the built package: the
 // keys, types and doc comments of `PipelineOptions` in pkg/node's .d.ts
 // (themselves generated from `Params` in src/params.rs by build.rs) and the
 // presets' actual values from `defaultOptions()`.
 //
-//   node scripts/gen-js-docs.mjs          rewrite the table in README.md
-//   node scripts/gen-js-docs.mjs --check  exit 1 when README.md is stale
+//   node scripts/gen-js-docs.mjs          rewrite the table in docs/API.md
+//   node scripts/gen-js-docs.mjs --check  exit 1 when docs/API.md is stale
 //
 // The Node tests import the helpers to check the docs against the values.
 import fs from "node:fs";
@@ -101,21 +101,21 @@ export function optionsTable() {
 }
 
 if (process.argv[1] && path.resolve(process.argv[1]) === fileURLToPath(import.meta.url)) {
-  const file = path.join(root, "README.md");
+  const file = path.join(root, "docs/API.md");
   const readme = fs.readFileSync(file, "utf8");
   const [a, b] = [readme.indexOf(START), readme.indexOf(END)];
   if (a < 0 || b < a) {
-    console.error(`README.md has no ${START} ... ${END} block`);
+    console.error(`docs/API.md has no ${START} ... ${END} block`);
     process.exit(1);
   }
   const next = `${readme.slice(0, a + START.length)}\n${optionsTable()}\n${readme.slice(b)}`;
   if (process.argv.includes("--check")) {
     if (next !== readme) {
-      console.error("README.md's options table is stale: run node scripts/gen-js-docs.mjs");
+      console.error("docs/API.md's options table is stale: run node scripts/gen-js-docs.mjs");
       process.exit(1);
     }
   } else if (next !== readme) {
     fs.writeFileSync(file, next);
-    console.log("README.md: options table updated");
+    console.log("docs/API.md: options table updated");
   }
 }

@@ -5,7 +5,7 @@
 //! (JSON snapshots and the JS options), where it lives in [`Params`], its
 //! unit, its valid range and its documentation. From that table come the
 //! serde form, [`Params::validate`], the TypeScript `PipelineOptions` (by
-//! `build.rs`) and the README's options table (from the TypeScript).
+//! `build.rs`) and the options table of docs/API.md (from the TypeScript).
 //!
 //! In Rust the parameters that differ between the ground and other
 //! surfaces are grouped in a [`SurfaceParams`] each, chosen by
@@ -63,7 +63,7 @@ pub struct SurfaceParams {
 /// Every tunable of detection and expansion. Distances in metres, areas in
 /// square metres, angles in degrees. The documentation of each option, its
 /// default and its range is in the options table (`table.rs`, shown in the
-/// README and the TypeScript `PipelineOptions`); the fields name their
+/// docs/API.md and the TypeScript `PipelineOptions`); the fields name their
 /// option key.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(from = "Wire", into = "Wire")]

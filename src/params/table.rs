@@ -3,7 +3,7 @@
 // its Rust type, where it lives in `Params`, its unit, its valid range and
 // its documentation (which gives the default). Included by
 // `src/params/mod.rs` (serde form, validation) and by `build.rs` (the
-// TypeScript `PipelineOptions`, from which the README table is made).
+// TypeScript `PipelineOptions`, from which the table of docs/API.md is made).
 // The order is the order of the keys in snapshots.
 options! {
     /// Inlier distance to a plane for non-ground planes (m). Default 0.10,
