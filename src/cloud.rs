@@ -304,21 +304,17 @@ impl Cloud {
     pub fn from_sensor_f64(values: &[f64], stride: usize, pose: &DMat4) -> Result<Self> {
         check_layout(values.len(), stride)?;
         let t = check_pose(pose)?;
-        let mut world = Vec::with_capacity(values.len() / stride);
-        for (i, p) in values.chunks_exact(stride).enumerate() {
-            let v = DVec3::new(p[0], p[1], p[2]);
-            if !v.is_finite() {
-                return Err(Error::NonFinite { point: i });
-            }
-            let w = pose.transform_point3(v);
-            if !w.is_finite() || w.abs().max_element() > MAX_COORDINATE {
-                return Err(Error::OutOfRange {
-                    point: i,
-                    limit: MAX_COORDINATE,
-                });
-            }
-            world.push(w);
+        let at = |p: &[f64]| DVec3::new(p[0], p[1], p[2]);
+        if let Some(i) = values.chunks_exact(stride).position(|p| !at(p).is_finite()) {
+            return Err(Error::NonFinite { point: i });
         }
+        // A rigid pose of a finite point is finite (or overflows to an
+        // infinity, which is out of range).
+        let world: Vec<DVec3> = values
+            .chunks_exact(stride)
+            .map(|p| pose.transform_point3(at(p)))
+            .collect();
+        check_range(world.iter().copied())?;
         let sensor = t.round();
         let near = world
             .iter()
