@@ -66,8 +66,12 @@ function assertPlane(found, where) {
   assert.ok(p.xmin > 1.9 && p.xmin < 2.3 && p.xmax > 11.7 && p.xmax < 12.1, `${where}: x from ${p.xmin} to ${p.xmax}`);
 }
 
+// Tools print plain text here whatever the CI's colour settings, so their
+// output can be matched as it reads.
+const PLAIN = { ...process.env, NO_COLOR: '1', FORCE_COLOR: '0' };
+
 function run(cmd, args, opts = {}) {
-  const r = spawnSync(cmd, args, { cwd: app, encoding: 'utf8', timeout: 180_000, ...opts });
+  const r = spawnSync(cmd, args, { cwd: app, encoding: 'utf8', timeout: 180_000, env: PLAIN, ...opts });
   assert.equal(r.status, 0, `${cmd} ${args.join(' ')} failed:\n${r.stdout}\n${r.stderr}`);
   return r;
 }
@@ -349,12 +353,19 @@ test("Vite's dev server, no config: the same app in Chromium", async () => {
       probe.close(() => resolve(p));
     });
   });
-  const dev = spawn(path.join(TOOLS, 'vite'), ['--port', String(port), '--strictPort', '--host', '127.0.0.1'], { cwd: dir, stdio: ['ignore', 'pipe', 'pipe'] });
+  const dev = spawn(path.join(TOOLS, 'vite'), ['--port', String(port), '--strictPort', '--host', '127.0.0.1'], {
+    cwd: dir,
+    stdio: ['ignore', 'pipe', 'pipe'],
+    env: PLAIN,
+  });
   let output = '';
   dev.stdout.on('data', (d) => (output += d));
   dev.stderr.on('data', (d) => (output += d));
   try {
-    for (const t0 = Date.now(); !output.includes(`:${port}`); ) {
+    // Vite may still colour its banner (the port in bold) when the CI sets
+    // FORCE_COLOR, so escape sequences are dropped before looking for it.
+    const plain = () => output.replace(/\x1b\[[0-9;]*m/g, '');
+    for (const t0 = Date.now(); !plain().includes(`:${port}/`); ) {
       assert.ok(Date.now() - t0 < 30_000 && dev.exitCode === null, `vite dev did not start: ${output}`);
       await new Promise((r) => setTimeout(r, 100));
     }
