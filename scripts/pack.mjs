@@ -13,7 +13,10 @@
 //                       ES module face: one wasm instance for both)
 //     worker/           www/src/worker.js and client.js (polyscene/worker), index.js
 //     geo/              js/geo.mjs and js/geo.d.mts as index.js, index.d.ts (polyscene/geo;
-//                       the package's one dependency, proj4, is for it)
+//                       the dependency proj4 is for it)
+//     io/               js/io.mjs and js/io.d.mts as index.js, index.d.ts (polyscene/io;
+//                       the dependencies @loaders.gl/las and its peer @loaders.gl/core
+//                       are for it)
 //
 // Every other file or folder under npm/ is copied as it is: a new subpath
 // (say polyscene/geo) is a folder npm/geo/ and one line in npm/package.json's
@@ -201,6 +204,10 @@ for (const f of ['worker.js', 'client.js']) {
 // geo/: polyscene/geo (js/geo.mjs, its types js/geo.d.mts), unchanged.
 write('geo/index.js', read('js/geo.mjs'));
 write('geo/index.d.ts', read('js/geo.d.mts'));
+
+// io/: polyscene/io (js/io.mjs, its types js/io.d.mts), unchanged.
+write('io/index.js', read('js/io.mjs'));
+write('io/index.d.ts', read('js/io.d.mts'));
 
 // The manifest: version and description from Cargo.toml; "files" is every
 // top-level entry assembled here (npm adds package.json itself).

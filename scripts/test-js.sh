@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Tests of the JS package (assumes `scripts/setup.sh all` ran):
-#   1. build pkg/ (scripts/build-wasm.sh; quick when nothing changed) and
-#      the native CLI the Node tests compare against;
+#   1. build pkg/ (scripts/build-wasm.sh; quick when nothing changed),
+#      the native CLI the Node tests compare against, and examples/write_las
+#      (tests/js/io.test.mjs's LAZ files: no JS library writes LAZ);
 #   2. the binding layer under Node: wasm-pack test --node (tests/wasm.rs);
 #   3. the package against pkg/node: node --test tests/js/.
 set -euo pipefail
@@ -9,8 +10,8 @@ cd "$(dirname "$0")/.."
 export PATH="$PWD/www/node_modules/.bin:$HOME/.cargo/bin:$PATH"
 
 scripts/build-wasm.sh
-echo "test-js: cargo build --release --bin polyscene (the native reference)"
-cargo build --release --quiet --bin polyscene
+echo "test-js: cargo build --release --bin polyscene --example write_las (the native reference; LAZ fixtures)"
+cargo build --release --quiet --bin polyscene --example write_las
 
 echo "test-js: wasm-pack test --node (tests/wasm.rs)"
 wasm-pack --log-level warn test --node -- --test wasm 2>&1 |

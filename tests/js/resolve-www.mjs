@@ -2,16 +2,15 @@
 // a bare import (proj4) that nothing nearer provides resolves from
 // www/node_modules, where scripts/setup.sh installs the page's packages.
 // Installed as a package, the same import resolves from its dependencies.
-import { createRequire } from "node:module";
-import { pathToFileURL } from "node:url";
-
-const wwwRequire = createRequire(new URL("../../www/package.json", import.meta.url));
+const www = new URL("../../www/package.json", import.meta.url).href;
 
 export async function resolve(specifier, context, next) {
   try {
     return await next(specifier, context);
   } catch (e) {
     if (e?.code !== "ERR_MODULE_NOT_FOUND" || /^(\.|\/|[a-z]+:)/.test(specifier)) throw e;
-    return { url: pathToFileURL(wwwRequire.resolve(specifier)).href, shortCircuit: true };
+    // Resolved as an import from www/ (the ES module entry, as a bundler or
+    // an installed package gets), not through require (CommonJS entry).
+    return next(specifier, { ...context, parentURL: www });
   }
 }
