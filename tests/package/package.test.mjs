@@ -98,7 +98,7 @@ after(async () => {
 
 test('the tarball: one package, licences, types, an exports map, no placeholder URL', () => {
   const files = execFileSync('tar', ['tzf', tarball], { encoding: 'utf8' }).split('\n').filter(Boolean);
-  for (const f of ['LICENSE-MIT', 'LICENSE-APACHE', 'README.md', 'web/polyscene.d.ts', 'web/polyscene_bg.wasm', 'node/polyscene.cjs', 'worker/worker.js', 'geo/index.js', 'geo/index.d.ts']) {
+  for (const f of ['LICENSE-MIT', 'LICENSE-APACHE', 'README.md', 'web/polyscene.d.ts', 'web/polyscene_bg.wasm', 'node/polyscene.cjs', 'worker/worker.js', 'geo/index.js', 'geo/index.d.ts', 'io/index.js', 'io/index.d.ts']) {
     assert.ok(files.includes(`package/${f}`), `${f} in the tarball`);
   }
   assert.equal(files.filter((f) => f.endsWith('.wasm')).length, 1, 'one copy of the wasm');
@@ -190,6 +190,7 @@ test('the .d.ts compiles under tsc --strict with the ES2022 libs (bundler and no
     path.join(app, 'typed.ts'),
     `import init, { Scenario, detect, simulate, defaultOptions, type Polygon } from "polyscene";
 import { PolysceneClient } from "polyscene/worker";
+import { readPoints, kittiSequence, type PointCloud } from "polyscene/io";
 await init();
 const s = new Scenario();
 const sim = simulate();
@@ -203,6 +204,11 @@ const client = new PolysceneClient();
 client.addEventListener("scan", (e) => console.log(e.detail.report.polygonCount));
 const p: Promise<Polygon[]> = client.detect(new Float32Array(9), { stride: 3 }, { signal: new AbortController().signal });
 console.log(n, found, d.minArea, p);
+const cloud: PointCloud = await readPoints(new Uint8Array(16), { name: "scan.bin", stride: 4 });
+const epsg: string | undefined = cloud.crs?.definition;
+const seq = await kittiSequence({ scans: [new File([new Uint8Array(16)], "000000.bin")], poses: "1 0 0 0 0 1 0 0 0 0 1 0", calib: "Tr: 1 0 0 0 0 1 0 0 0 0 1 0" });
+for await (const k of seq) s.addScan(k.points, { stride: k.stride, pose: k.pose });
+console.log(detect(cloud.points, { stride: cloud.stride }), epsg);
 `,
   );
   const tsc = path.join(TOOLS, 'tsc');
@@ -221,6 +227,111 @@ console.log(n, found, d.minArea, p);
   );
   fs.writeFileSync(path.join(app, 'tsconfig.node.json'), config('node16', ['typed-node.mts', 'typed-node.cts']));
   run(tsc, ['-p', 'tsconfig.node.json']);
+});
+
+const FIXTURES = pathToFileURL(path.join(ROOT, 'tests/js/io-fixtures.mjs')).href;
+
+test('Node ESM: polyscene/io reads LAS at UTM (with its CRS, through @loaders.gl/las installed as a dependency), PCD, PLY and a KITTI sequence with calib; polygons equal the local .bin\'s to 1 mm', () => {
+  fs.writeFileSync(
+    path.join(app, 'io.mjs'),
+    `import { detect, simulate, Scenario } from "polyscene";
+     import { readPoints, readKittiBin, kittiSequence } from "polyscene/io";
+     import * as fx from "${FIXTURES}";
+     const sim = simulate({ layout: "street", seed: 1 });
+     const pts = fx.onGrid(sim.scan(0).points, 4);
+     const local = await readKittiBin(fx.rawBin(pts), { name: "local.bin" });
+     const want = detect(local.points, { stride: local.stride, viewpoint: [0, 0, 0] });
+     /** Largest vertex distance (m) to want's once moved back by shift, or a mismatch. */
+     const gap = (got, shift, ref = want) => {
+       if (got.length !== ref.length) return "count " + got.length + " vs " + ref.length;
+       let d = 0;
+       got.forEach((p, k) => {
+         if (p.vertices.length !== ref[k].vertices.length) d = Infinity;
+         else p.vertices.forEach((v, j) => (d = Math.max(d, Math.abs(v - shift[j % 3] - ref[k].vertices[j]))));
+       });
+       return d;
+     };
+     const out = { polygons: want.length, files: {} };
+     for (const [name, bytes, shift] of [
+       ["utm.las", fx.las(pts, fx.UTM, { crs: { epsg: 32632 } }), fx.UTM],
+       ["utm-1.4.las", fx.las(pts, fx.UTM, { version: "1.4" }), fx.UTM],
+       ["utm-binary.pcd", fx.pcd(pts, "binary", fx.UTM), fx.UTM],
+       ["ascii.pcd", fx.pcd(pts, "ascii"), [0, 0, 0]],
+       ["utm-binary.ply", fx.ply(pts, "le64", fx.UTM), fx.UTM],
+       ["ascii.ply", fx.ply(pts, "ascii"), [0, 0, 0]],
+     ]) {
+       const c = await readPoints(bytes, { name });
+       out.files[name] = { format: c.format, crs: c.crs?.definition, f64: c.points instanceof Float64Array, gap: gap(detect(c.points, { stride: c.stride, viewpoint: shift }), shift) };
+     }
+     try { await readPoints(fx.ply(pts.slice(0, 500), "ascii").subarray(0, 300), { name: "cut.ply" }); } catch (e) { out.cut = e.message; }
+     // A KITTI sequence: camera poses and calib.txt.
+     const drive = simulate({ layout: "street", seed: 2 });
+     const scans = [0, 1, 2, 3].map((k) => drive.scan(k));
+     const tr = fx.calibTr();
+     const poses = scans.map((s) => fx.poseLine(fx.mat4Mul(fx.mat4Mul(tr, Float64Array.from(s.pose)), fx.mat4Inverse(tr)))).join("\\n");
+     const map = async (list) => {
+       const sc = new Scenario();
+       for await (const s of list) sc.addScan(s.points, { stride: 4, pose: s.pose });
+       return sc.polygons();
+     };
+     const seq = await kittiSequence({ scans: scans.map((s, k) => ({ name: "00000" + k + ".bin", data: s.points })), poses, calib: fx.CALIB_00 });
+     const ref = await map(scans);
+     out.kitti = { polygons: ref.length, gap: gap(await map(seq), [0, 0, 0], ref) };
+     console.log(JSON.stringify(out));`,
+  );
+  const out = JSON.parse(run('node', ['io.mjs']).stdout);
+  assert.ok(out.polygons >= 10, `${out.polygons} polygons`);
+  for (const [name, r] of Object.entries(out.files)) {
+    assert.ok(typeof r.gap === 'number' && r.gap <= 1e-3, `${name}: ${JSON.stringify(r)}`);
+    assert.equal(r.f64, name.startsWith('utm'), `${name}: float64 at map coordinates`);
+  }
+  assert.equal(out.files['utm.las'].crs, 'EPSG:32632');
+  assert.equal(out.files['utm.las'].format, 'las');
+  assert.match(out.cut, /cut\.ply: PLY vertex \d+ of 500: the file ends there/);
+  assert.ok(out.kitti.polygons >= 5 && out.kitti.gap <= 1e-3, `KITTI: ${JSON.stringify(out.kitti)}`);
+});
+
+test('Vite: polyscene/io in a production build, in Chromium: a LAS at UTM with its CRS (@loaders.gl/las bundled) and a binary PLY', async () => {
+  const dir = path.join(app, 'vite-io');
+  fs.mkdirSync(dir, { recursive: true });
+  fs.copyFileSync(fileURLToPath(FIXTURES), path.join(dir, 'io-fixtures.mjs'));
+  fs.writeFileSync(
+    path.join(dir, 'main.mjs'),
+    `import init, { detect } from "polyscene";
+import { readPoints } from "polyscene/io";
+import { las, ply, UTM } from "./io-fixtures.mjs";
+const out = {};
+try {
+  await init();
+  // A 10 m x 10 m floor, 10 cm spacing, at UTM coordinates.
+  const pts = [];
+  for (let i = 0; i <= 100; i++) for (let j = 0; j <= 100; j++) pts.push([i / 10, j / 10, 0]);
+  for (const [name, bytes] of [["floor.las", las(pts, UTM, { crs: { epsg: 32632 } })], ["floor.ply", ply(pts, "le64", UTM)]]) {
+    const c = await readPoints(new File([bytes], name));
+    const found = detect(c.points, { stride: c.stride, viewpoint: [UTM[0] + 5, UTM[1] + 5, UTM[2] + 2] });
+    out[name] = { format: c.format, count: c.count, crs: c.crs?.definition, f64: c.points instanceof Float64Array, polygons: found.length, area: found[0]?.area, x0: Math.min(...Array.from(found[0]?.vertices ?? []).filter((_, k) => k % 3 === 0)) };
+  }
+} catch (e) {
+  out.error = String((e && e.stack) || e);
+}
+window.__results = out;
+`,
+  );
+  fs.writeFileSync(path.join(dir, 'index.html'), '<!doctype html><meta charset="utf-8"><script type="module" src="./main.mjs"></script>');
+  const r = run(path.join(TOOLS, 'vite'), ['build', '--logLevel', 'warn', '--outDir', 'dist', '--emptyOutDir'], { cwd: dir });
+  // @loaders.gl/las's bundled LAZ decoder (laz-perf, emscripten) assigns
+  // module.exports behind a typeof check; Rolldown notes it. Nothing else.
+  const warnings = (r.stdout + r.stderr).split('\n').filter((l) => /warn|\[[A-Z_]+\]/i.test(l));
+  assert.ok(warnings.every((l) => /COMMONJS_VARIABLE_IN_ESM/.test(l)), `Vite warned: ${warnings.join('\n')}`);
+  const { results } = await inChromium(path.join(dir, 'dist'));
+  assert.equal(results.error, undefined, results.error);
+  for (const name of ['floor.las', 'floor.ply']) {
+    const f = results[name];
+    assert.ok(f.f64 && f.count === 101 * 101 && f.polygons === 1, `${name}: ${JSON.stringify(f)}`);
+    assert.ok(Math.abs(f.area - 100) < 2 && Math.abs(f.x0 - 500_000) < 0.2, `${name}: ${JSON.stringify(f)}`);
+  }
+  assert.equal(results['floor.las'].format, 'las');
+  assert.equal(results['floor.las'].crs, 'EPSG:32632');
 });
 
 /** Serve `dir`, open `page` in Chromium, wait for window.__results (and a console line matching `waitLog`); return it and the console lines. */
