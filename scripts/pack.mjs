@@ -16,7 +16,7 @@
 //                       the dependency proj4 is for it)
 //     io/               js/io.mjs and js/io.d.mts as index.js, index.d.ts (polyscene/io;
 //                       the dependencies @loaders.gl/las and its peer @loaders.gl/core
-//                       are for it)
+//                       are for it); js/io-node.mjs as node.js (polyscene/io/node)
 //
 // Every other file or folder under npm/ is copied as it is: a new subpath
 // (say polyscene/geo) is a folder npm/geo/ and one line in npm/package.json's
@@ -205,9 +205,18 @@ for (const f of ['worker.js', 'client.js']) {
 write('geo/index.js', read('js/geo.mjs'));
 write('geo/index.d.ts', read('js/geo.d.mts'));
 
-// io/: polyscene/io (js/io.mjs, its types js/io.d.mts), unchanged.
+// io/: polyscene/io (js/io.mjs, its types js/io.d.mts), unchanged, and
+// polyscene/io/node (js/io-node.mjs: file paths), whose import of the
+// readers names the package's file.
 write('io/index.js', read('js/io.mjs'));
 write('io/index.d.ts', read('js/io.d.mts'));
+{
+  const from = "from './io.mjs';";
+  const text = read('js/io-node.mjs');
+  if (!text.includes(from)) fail(`js/io-node.mjs does not import ${from}`);
+  write('io/node.js', text.replace(from, "from './index.js';"));
+  write('io/node.d.ts', read('js/io-node.d.mts').replace("from './io.mjs';", "from './index.js';"));
+}
 
 // The manifest: version and description from Cargo.toml; "files" is every
 // top-level entry assembled here (npm adds package.json itself).

@@ -11,7 +11,7 @@ import { register } from "node:module";
 import { execFileSync } from "node:child_process";
 import fs from "node:fs";
 import path from "node:path";
-import { ps, repoRoot, tempDir } from "./common.mjs";
+import { cli, ps, repoRoot, tempDir } from "./common.mjs";
 import * as fx from "./io-fixtures.mjs";
 
 register("./resolve-www.mjs", import.meta.url);
@@ -267,4 +267,47 @@ test("the LZF decoder of binary_compressed PCD reads back references and literal
   for (let k = 0; k < n; k++) {
     for (let a = 0; a < 3; a++) assert.equal(cloud.points[3 * k + a], data[a * n + k], `point ${k} axis ${a}`);
   }
+});
+
+test("polyscene/io/node: a KITTI dataset root on disk gives the CLI's replay map, to 1 mm (the conventions of src/io/kitti.rs); files by path", async () => {
+  const node = await import("../../js/io-node.mjs");
+  const dir = tempDir("io-kitti");
+  const drive = ps.simulate({ layout: "street", seed: 2 });
+  const tr = fx.calibTr();
+  const root = path.join(dir, "dataset");
+  const seq = path.join(root, "sequences", "00");
+  fs.mkdirSync(path.join(seq, "velodyne"), { recursive: true });
+  fs.mkdirSync(path.join(root, "poses"));
+  const lines = [];
+  for (let k = 0; k < 5; k++) {
+    const s = drive.scan(k);
+    fs.writeFileSync(path.join(seq, "velodyne", `${String(k).padStart(6, "0")}.bin`), new Uint8Array(s.points.buffer, s.points.byteOffset, s.points.byteLength));
+    lines.push(fx.poseLine(fx.mat4Mul(fx.mat4Mul(tr, Float64Array.from(s.pose)), fx.mat4Inverse(tr))));
+  }
+  drive.free();
+  fs.writeFileSync(path.join(root, "poses", "00.txt"), lines.join("\n") + "\n");
+  fs.writeFileSync(path.join(seq, "calib.txt"), fx.CALIB_00);
+
+  const want = JSON.parse(cli("replay", root, "--sequence", "00")).polygons.map((p) => ({ ...p, vertices: p.vertices.flat() }));
+  assert.ok(want.length >= 10, `${want.length} polygons`);
+  const scenario = new ps.Scenario(); // the CLI's defaults
+  const sequence = await node.openKittiSequence(root); // one sequence: no need to name it
+  assert.equal(sequence.length, 5);
+  for await (const scan of sequence) scenario.addScan(scan.points, { stride: scan.stride, pose: scan.pose });
+  assertSamePolygons("openKittiSequence vs polyscene replay", scenario.polygons(), [0, 0, 0], want);
+  scenario.free();
+  // The sequence folder itself, and its refusal without calib.txt.
+  assert.equal((await node.openKittiSequence(seq)).length, 5);
+  fs.renameSync(path.join(seq, "calib.txt"), path.join(dir, "calib-00.txt"));
+  await rejects(node.openKittiSequence(root), /00\.txt/, /calib\.txt/, /lidarPoses/);
+  assert.equal((await node.openKittiSequence(root, { calib: path.join(dir, "calib-00.txt") })).length, 5);
+
+  // Point files by path; a missing one names itself.
+  const las = path.join(dir, "utm.las");
+  fs.writeFileSync(las, fx.las(POINTS.slice(0, 1000), fx.UTM, { crs: { epsg: 32633 } }));
+  const cloud = await node.readPointsFile(las);
+  assert.equal(cloud.count, 1000);
+  assert.equal(cloud.crs.definition, "EPSG:32633");
+  assert.equal(cloud.name, las);
+  await rejects(node.readPointsFile(path.join(dir, "none.las")), /none\.las: cannot read/);
 });
