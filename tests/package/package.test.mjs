@@ -219,7 +219,7 @@ console.log(detect(cloud.points, { stride: cloud.stride }), epsg);
   run(tsc, ['-p', 'tsconfig.bundler.json']);
   fs.writeFileSync(
     path.join(app, 'typed-node.mts'),
-    `import init, { detect } from "polyscene";\nawait init();\nconst n: number = detect(new Float32Array(9), { stride: 3 }).length;\nconsole.log(n);\n`,
+    `import init, { detect } from "polyscene";\nimport { readPointsFile, openKittiSequence } from "polyscene/io/node";\nawait init();\nconst n: number = detect(new Float32Array(9), { stride: 3 }).length;\nconst c = await readPointsFile("scan.las");\nconst seq = await openKittiSequence("kitti", { sequence: "00", calib: "calib.txt" });\nconsole.log(n, c.crs?.epsg, seq.length);\n`,
   );
   fs.writeFileSync(
     path.join(app, 'typed-node.cts'),
