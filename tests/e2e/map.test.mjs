@@ -230,6 +230,101 @@ test('a KITTI .bin on the map: polygons around the origin of the form; a bad fil
   await page.close();
 });
 
+/** Latitude (degrees) on the central meridian of a transverse Mercator zone (k0 0.9996) at a northing: the meridian arc, by Simpson's rule and bisection. */
+function latitudeOfNorthing(northing) {
+  const M = (phi) => (A * (1 - E2)) / (1 - E2 * Math.sin(phi) ** 2) ** 1.5;
+  const arc = (phi) => {
+    const n = 2000;
+    const h = phi / n;
+    let s = M(0) + M(phi);
+    for (let i = 1; i < n; i++) s += (i % 2 ? 4 : 2) * M(i * h);
+    return (s * h) / 3;
+  };
+  let [lo, hi] = [0, Math.PI / 2];
+  for (let k = 0; k < 60; k++) {
+    const mid = (lo + hi) / 2;
+    if (0.9996 * arc(mid) < northing) lo = mid;
+    else hi = mid;
+  }
+  return lo / RAD;
+}
+
+test('a LAS with its CRS on the map (polyscene/io): the frame becomes EPSG:32632 and the floor lands at its UTM square; a bad LAS says so', { timeout: 60_000 }, async () => {
+  const fx = await import(pathToFileURL(path.join(ROOT, 'tests/js/io-fixtures.mjs')).href);
+  // A 10 m x 10 m floor from (500000, 4500000) in UTM zone 32N: easting 500000 is its central meridian, 9 degrees east.
+  const pts = [];
+  for (let i = 0; i <= 100; i++) for (let j = 0; j <= 100; j++) pts.push([i / 10, j / 10, 0]);
+  const las = path.join(scratch, 'floor-utm32.las');
+  writeFileSync(las, fx.las(pts, [500_000, 4_500_000, 50], { crs: { epsg: 32632 } }));
+  const page = await context.newPage();
+  await page.goto(mapUrl(), { waitUntil: 'load' });
+  await page.waitForFunction(() => window.polysceneMap?.state.mapReady, null, { timeout: 30_000 });
+  await page.setInputFiles('#scan-input', las);
+  await page.waitForFunction(() => window.polysceneMap.state.source.includes('floor-utm32.las'), null, { timeout: 45_000 });
+  const got = await page.evaluate(async () => {
+    const { map, state } = window.polysceneMap;
+    const footprints = await map.getSource('footprints').getData();
+    return { source: state.source, crs: document.getElementById('f-crs').value, rings: footprints.features.map((f) => [f.properties.kind, f.geometry.coordinates[0]]) };
+  });
+  assert.match(got.source, /LAS · one-shot · placed by its CRS, EPSG:32632/);
+  assert.equal(got.crs, 'EPSG:32632');
+  assert.equal(got.rings.length, 1, JSON.stringify(got.rings));
+  const [kind, ring] = got.rings[0];
+  assert.equal(kind, 'ground');
+  // Back to metres east and north of the square's corner (scale 0.9996 on the central meridian).
+  const phi0 = latitudeOfNorthing(4_500_000);
+  const w = 1 - E2 * Math.sin(phi0 * RAD) ** 2;
+  const east = (lon) => (lon - 9) * RAD * (A / Math.sqrt(w)) * Math.cos(phi0 * RAD) * 0.9996;
+  const north = (lat) => (lat - phi0) * RAD * ((A * (1 - E2)) / w ** 1.5) * 0.9996;
+  const es = ring.map(([lon]) => east(lon));
+  const ns = ring.map(([, lat]) => north(lat));
+  const box = [Math.min(...es), Math.max(...es), Math.min(...ns), Math.max(...ns)];
+  for (const [v, want] of box.map((v, k) => [v, [0, 10, 0, 10][k]])) assert.ok(Math.abs(v - want) < 0.3, `the floor spans ${box.map((b) => b.toFixed(3))} m, not 0..10 x 0..10`);
+  await page.screenshot({ path: path.join(OUT, 'map-las.png') });
+  const bad = path.join(scratch, 'cut.las');
+  writeFileSync(bad, fx.las(pts, [500_000, 4_500_000, 50]).subarray(0, 100));
+  await page.setInputFiles('#scan-input', bad);
+  await page.locator('.toast.error', { hasText: 'cut.las: LAS header cut short' }).waitFor({ timeout: 10_000 });
+  await page.close();
+});
+
+test('KITTI scans with camera poses and calib.txt on the map (polyscene/io): the vehicle at the LiDAR positions', { timeout: 60_000 }, async () => {
+  const fx = await import(pathToFileURL(path.join(ROOT, 'tests/js/io-fixtures.mjs')).href);
+  const sim = ps.simulate({ layout: 'street', seed: 2 });
+  const dir = path.join(scratch, 'kitti');
+  mkdirSync(dir, { recursive: true });
+  const tr = fx.calibTr();
+  const files = [];
+  const lidar = [];
+  const lines = [];
+  for (let k = 0; k < 3; k++) {
+    const s = sim.scan(k * 4);
+    const f = path.join(dir, `${String(k).padStart(6, '0')}.bin`);
+    writeFileSync(f, new Uint8Array(s.points.buffer, s.points.byteOffset, s.points.byteLength));
+    files.push(f);
+    lidar.push([s.pose[12], s.pose[13]]);
+    lines.push(fx.poseLine(fx.mat4Mul(fx.mat4Mul(tr, Float64Array.from(s.pose)), fx.mat4Inverse(tr))));
+  }
+  sim.free();
+  writeFileSync(path.join(dir, '00.txt'), `${lines.join('\n')}\n`);
+  writeFileSync(path.join(dir, 'calib.txt'), fx.CALIB_00);
+  const page = await context.newPage();
+  await page.goto(mapUrl(), { waitUntil: 'load' });
+  await page.waitForFunction(() => window.polysceneMap?.state.mapReady, null, { timeout: 30_000 });
+  await page.setInputFiles('#scan-input', [...files, path.join(dir, '00.txt'), path.join(dir, 'calib.txt')]);
+  await page.waitForFunction(() => window.polysceneMap.state.source.includes('calib.txt') && window.polysceneMap.state.scans === 3, null, { timeout: 45_000 });
+  const trail = await page.evaluate(async () => {
+    const data = await window.polysceneMap.map.getSource('trail').getData();
+    return data.geometry.coordinates;
+  });
+  assert.equal(trail.length, 3);
+  trail.forEach((p, k) => {
+    const d = metresApart(p, lonLatByHand(lidar[k][0], lidar[k][1]));
+    assert.ok(d < 0.01, `scan ${k}: the vehicle is ${d} m from its LiDAR position`);
+  });
+  await page.close();
+});
+
 test('the main page links to the map and loads a snapshot', { timeout: 60_000 }, async () => {
   const page = await context.newPage();
   await page.goto(server.url, { waitUntil: 'load' });

@@ -2,8 +2,10 @@
 // (MapLibre GL JS), in longitude and latitude through polyscene/geo.
 //
 // Fed by the same worker as the 3D view (src/worker.js via src/client.js):
-// the simulated drive live, the user's scans (KITTI .bin + poses.txt, PCD,
-// PLY) placed at the frame's origin, or a saved snapshot. Ground and other
+// the simulated drive live, the user's scans (KITTI .bin + poses.txt, with
+// calib.txt for KITTI's camera poses) placed at the frame's origin, one
+// LAS/LAZ, PCD or PLY cloud through polyscene/io (one-shot detection; a LAS
+// with a CRS sets the frame to it), or a saved snapshot. Ground and other
 // polygons are drawn as footprints, walls as thin extruded outlines of their
 // height. Offline: the style is one background layer, no tiles, no glyphs,
 // no sprites; every file comes from this server.
@@ -18,6 +20,7 @@ import * as maplibregl from 'maplibre-gl';
 import { geoFrame, mapFeatures } from 'polyscene/geo';
 import { PolysceneClient } from './client.js';
 import { readScanFiles, FileError } from './files.js';
+import { kittiSequence, readPoints, sniffFormat } from 'polyscene/io';
 
 const $ = (id) => document.getElementById(id);
 const EMPTY = { type: 'FeatureCollection', features: [] };
@@ -241,13 +244,58 @@ function runSim() {
 
 // ------------------------------------------------------------------ files
 
+/** The format of a file from its first bytes (polyscene/io's rules; throws on a format not read). */
+async function formatOf(file) {
+  return sniffFormat(new Uint8Array(await file.slice(0, 512).arrayBuffer()), file.name);
+}
+
+/** One LAS/LAZ, PCD or PLY cloud: read by polyscene/io, detected at once in the worker. */
+async function openCloud(file) {
+  const cloud = await readPoints(file);
+  let where = 'placed by the frame above';
+  if (cloud.crs) {
+    const spec = { crs: cloud.crs.definition };
+    state.frame = geoFrame(spec); // throws (a WKT proj4 cannot read): the frame stays
+    fillForm(spec);
+    where = `placed by its CRS, ${cloud.crs.epsg || cloud.crs.wktEpsg ? cloud.crs.definition : 'WKT'}`;
+  }
+  client.pause();
+  toast(`${file.name}: ${cloud.count.toLocaleString('en')} points (${cloud.format.toUpperCase()}), detecting…`, 'info');
+  const polygons = await client.detect(cloud.points, { ...OPTIONS, stride: cloud.stride });
+  state.polygons = polygons;
+  state.poses = [];
+  state.scans = 1;
+  state.total = 1;
+  state.source = `${file.name} · ${cloud.format.toUpperCase()} · one-shot · ${where}`;
+  $('source-label').textContent = state.source;
+  setStat('stat-scan', 1, 'one-shot');
+  redraw();
+  centre(true);
+}
+
+/** KITTI .bin scans with poses.txt and calib.txt: camera-0 poses turned into LiDAR poses by polyscene/io. */
+async function kittiWithCalib(files) {
+  const calib = files.find((f) => /calib/i.test(f.name));
+  const texts = files.filter((f) => f !== calib && f.name.toLowerCase().endsWith('.txt'));
+  if (texts.length !== 1) throw new FileError(`with ${calib.name}, give one poses file (KITTI's poses/NN.txt), not ${texts.length}`);
+  const seq = await kittiSequence({ scans: files.filter((f) => f.name.toLowerCase().endsWith('.bin')), poses: texts[0], calib });
+  const scans = [];
+  for await (const s of seq) scans.push({ name: s.name, points: s.points, pose: s.pose });
+  const label = `${scans.length} KITTI scans · ${scans[0].name} … ${scans.at(-1).name} · camera poses + ${calib.name}`;
+  return { label, scans };
+}
+
 async function openScans(files) {
   try {
-    const set = await readScanFiles(files);
+    if (files.length === 1 && (await formatOf(files[0])) !== 'raw') {
+      await openCloud(files[0]);
+      return;
+    }
+    const set = files.some((f) => /calib.*\.txt$/i.test(f.name)) ? await kittiWithCalib(files) : await readScanFiles(files);
     client.configure(OPTIONS, { kind: 'files', label: set.label, scans: set.scans }, { play: true });
     toast(`loaded ${set.label}`, 'info');
   } catch (e) {
-    toast(e instanceof FileError ? e.message : `could not read the files: ${e.message || e}`);
+    toast(e instanceof FileError || /^polyscene\/io: /.test(e?.message) ? e.message : `could not read the files: ${e.message || e}`);
   }
 }
 
