@@ -122,8 +122,8 @@ function isPcd(bytes) {
  * errors (a File's own name is used otherwise).
  *
  * Resolves to `{ points, stride, count, format, name, crs? }` (see io.d.ts).
- * Rejects with an Error naming the file and the problem: empty (0 bytes), a
- * header of another format or a text file, a size that is not a whole
+ * Rejects with an Error naming the file and the problem: empty (0 bytes) or
+ * a header with no points, a header of another format or a text file, a size that is not a whole
  * number of points, a file cut short, NaN or infinite coordinates, a format
  * without x, y, z.
  */
@@ -131,13 +131,17 @@ export async function readPoints(input, options = {}) {
   const { bytes, name } = await bytesOf(input, options.name);
   if (bytes.length === 0) throw ioError(name, 'empty file (0 bytes): no points');
   const format = sniffFormat(bytes.subarray(0, 512), name);
+  const some = (cloud, why) => {
+    if (cloud.count === 0) throw ioError(name, `a ${format.toUpperCase()} file with no points (${why})`);
+    return cloud;
+  };
   switch (format) {
     case 'las':
       return readLasBytes(bytes, name);
     case 'pcd':
-      return readPcdBytes(bytes, name);
+      return some(readPcdBytes(bytes, name), 'POINTS 0, or every point NaN: no return');
     case 'ply':
-      return readPlyBytes(bytes, name);
+      return some(readPlyBytes(bytes, name), 'element vertex 0');
     default: {
       const stride = options.stride;
       if (stride === undefined) {
@@ -204,7 +208,7 @@ const PLY_TYPES = {
 function plyHeader(bytes, name) {
   // The header is ASCII and ends with a line "end_header".
   let end = -1;
-  const limit = Math.min(bytes.length, 1 << 20);
+  const limit = Math.min(bytes.length, 1 << 16);
   const head = latin1(bytes, 0, limit);
   const m = /(^|\n)end_header\r?\n/.exec(head);
   if (m) end = m.index + m[0].length;

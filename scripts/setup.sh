@@ -2,7 +2,8 @@
 # Install what the build and the tests need, only when missing:
 #   rust    - the wasm32 target, wasm-bindgen-cli (same version as Cargo.lock), wasm-pack
 #   npm     - www/node_modules (three, lil-gui, playwright-core, binaryen for wasm-opt,
-#             fast-check for the fuzz test of the JS boundary);
+#             fast-check for the fuzz test of the JS boundary, maplibre-gl, proj4 and
+#             @loaders.gl/las for the map page and the tests of js/);
 #             tests/package/tools/node_modules (vite, esbuild, typescript: the
 #             package test builds a scratch project with them)
 #   browser - Debian's chromium for the end-to-end test

@@ -235,6 +235,8 @@ test("bad files are errors naming the file and the problem, never an empty resul
   await check("short.ply", text("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n1 2 3\n"), {}, /PLY vertex 1 of 3: the file ends there/);
   const le = fx.ply(POINTS.slice(0, 100), "le64", fx.UTM);
   await check("short-binary.ply", le.subarray(0, le.length - 8), {}, /PLY vertex 99 of 100: the file ends there/);
+  await check("novertex.ply", text("ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\nproperty float z\nend_header\n"), {}, /a PLY file with no points/);
+  await check("allnan.pcd", text("VERSION .7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\nnan nan nan\nnan nan nan\n"), {}, /a PCD file with no points/);
   await check("noend.ply", text("ply\nformat ascii 1.0\nelement vertex 1\n"), {}, /end_header/);
   await check("noz.pcd", text("VERSION .7\nFIELDS x y\nSIZE 4 4\nTYPE F F\nCOUNT 1 1\nWIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n1 2\n"), {}, /no 'z'/);
   await check("short.pcd", text("VERSION .7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\nHEIGHT 1\nPOINTS 3\nDATA binary\n\0\0\0\0"), {}, /PCD point 0 of 3: the file ends there/);
