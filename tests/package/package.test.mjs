@@ -291,7 +291,7 @@ test('Node ESM: polyscene/io reads LAS at UTM (with its CRS, through @loaders.gl
   assert.ok(out.kitti.polygons >= 5 && out.kitti.gap <= 1e-3, `KITTI: ${JSON.stringify(out.kitti)}`);
 });
 
-test('Vite: polyscene/io in a production build, in Chromium: a LAS at UTM with its CRS (@loaders.gl/las bundled) and a binary PLY', async () => {
+test('Vite and esbuild: polyscene/io in a production build, in Chromium: a LAS at UTM with its CRS (@loaders.gl/las bundled) and a binary PLY', async () => {
   const dir = path.join(app, 'vite-io');
   fs.mkdirSync(dir, { recursive: true });
   fs.copyFileSync(fileURLToPath(FIXTURES), path.join(dir, 'io-fixtures.mjs'));
@@ -332,6 +332,15 @@ window.__results = out;
   }
   assert.equal(results['floor.las'].format, 'las');
   assert.equal(results['floor.las'].crs, 'EPSG:32632');
+
+  // esbuild, no config (polyscene/inline for the wasm): no warning, same results.
+  const main = fs.readFileSync(path.join(dir, 'main.mjs'), 'utf8').replace('from "polyscene";', 'from "polyscene/inline";');
+  fs.writeFileSync(path.join(dir, 'main-esbuild.mjs'), main);
+  const es = run(path.join(TOOLS, 'esbuild'), ['main-esbuild.mjs', '--bundle', '--format=esm', '--splitting', '--outdir=dist-esbuild'], { cwd: dir });
+  assert.doesNotMatch(es.stderr, /warning/i, `esbuild warned: ${es.stderr}`);
+  fs.writeFileSync(path.join(dir, 'dist-esbuild/index.html'), '<!doctype html><meta charset="utf-8"><script type="module" src="./main-esbuild.js"></script>');
+  const again = (await inChromium(path.join(dir, 'dist-esbuild'))).results;
+  assert.deepEqual(again, results, 'esbuild gives what Vite gives');
 });
 
 /** Serve `dir`, open `page` in Chromium, wait for window.__results (and a console line matching `waitLog`); return it and the console lines. */
