@@ -274,6 +274,15 @@ function readPlyBytes(bytes, name) {
     return i;
   });
   const f32 = slots.every((i) => vertex.properties[i].type[0] === 'Float32');
+  // Before allocating: a vertex takes at least 2 bytes a property in ascii, its scalars in binary.
+  const least = vertex.properties.reduce((sum, p) => sum + (format === 'ascii' ? 2 : p.list ? p.countType[1] : p.type[1]), 0);
+  if (vertex.count * least > bytes.length - end + 1) {
+    if (format !== 'ascii' && vertex.properties.every((p) => !p.list) && elements[0] === vertex) {
+      const fit = Math.floor((bytes.length - end) / least);
+      throw ioError(name, `PLY vertex ${fit} of ${vertex.count}: the file ends there (${bytes.length} bytes; a truncated file?)`);
+    }
+    throw ioError(name, `the PLY header promises ${vertex.count} vertices; ${bytes.length - end} bytes of data cannot hold them (a truncated or damaged file?)`);
+  }
   const points = new (f32 ? Float32Array : Float64Array)(vertex.count * 3);
   const put = (k, values) => {
     const [x, y, z] = slots.map((i) => values[i]);
@@ -434,6 +443,17 @@ function readPcdBytes(bytes, name) {
     return i;
   });
   const f32 = index.every((i) => defs[i].type[0] === 'Float32');
+  // Before allocating: a point takes at least 2 bytes a value in ascii, its
+  // record in binary, and LZF expands at most about 100-fold.
+  const rowBytes = defs.reduce((s, d) => s + d.type[1] * d.count, 0);
+  const least = data === 'ascii' ? 2 * defs.reduce((s, d) => s + d.count, 0) : data === 'binary' ? rowBytes : rowBytes / 128;
+  if (promised * least > bytes.length - end + 1) {
+    if (data === 'binary') {
+      const fit = Math.max(0, Math.floor((bytes.length - end) / rowBytes));
+      throw ioError(name, `PCD point ${fit} of ${promised}: the file ends there (${bytes.length} bytes, ${rowBytes} a point; a truncated file?)`);
+    }
+    throw ioError(name, `the PCD header promises ${promised} points; ${bytes.length - end} bytes of data cannot hold them (a truncated or damaged file?)`);
+  }
   const out = new (f32 ? Float32Array : Float64Array)(promised * 3);
   let kept = 0;
   const put = (k, x, y, z) => {

@@ -232,7 +232,10 @@ test("bad files are errors naming the file and the problem, never an empty resul
   // PLY and PCD without z, or cut short; a bad magic after "ply".
   const text = (s) => new TextEncoder().encode(s);
   await check("noz.ply", text("ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nend_header\n1 2\n3 4\n"), {}, /no 'z'/);
-  await check("short.ply", text("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n1 2 3\n"), {}, /PLY vertex 1 of 3: the file ends there/);
+  await check("short.ply", text("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n1 2 3\n"), {}, /the PLY header promises 3 vertices; 6 bytes of data cannot hold them/);
+  await check("short2.ply", text("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n1.000 2.000 3.000\n4.000 5.000 6.000\n"), {}, /PLY vertex 2 of 3: the file ends there/);
+  await check("huge.ply", text("ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty double x\nproperty double y\nproperty double z\nend_header\n"), {}, /PLY vertex 0 of 4000000000: the file ends there/);
+  await check("huge.pcd", text("VERSION .7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 4000000000\nHEIGHT 1\nPOINTS 4000000000\nDATA ascii\n1 2 3\n"), {}, /promises 4000000000 points; 6 bytes of data cannot hold them/);
   const le = fx.ply(POINTS.slice(0, 100), "le64", fx.UTM);
   await check("short-binary.ply", le.subarray(0, le.length - 8), {}, /PLY vertex 99 of 100: the file ends there/);
   await check("novertex.ply", text("ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\nproperty float z\nend_header\n"), {}, /a PLY file with no points/);
