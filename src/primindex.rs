@@ -67,7 +67,7 @@ impl Reach {
             across: (params.ground.expand_across)
                 .max(params.other.expand_across)
                 .max(0.03),
-            merge: params.merge_gap + params.merge_distance.max(params.other.distance),
+            merge: params.merge_box_pad(),
         }
     }
 }

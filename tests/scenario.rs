@@ -169,11 +169,12 @@ fn drive_through(layout: Layout) {
             ..Params::gpp2()
         };
         let one = if paper {
-            Detector::new(&params, CascadePolicy::scenario_leftovers()).run(
-                &cloud.points,
-                cloud.origin,
-                mean_pose,
-            )
+            // The scenario's cascade with the paper's plain sampler.
+            let paper = CascadePolicy {
+                reject_slivers: false,
+                ..CascadePolicy::scenario_leftovers()
+            };
+            Detector::new(&params, paper).run(&cloud.points, cloud.origin, mean_pose)
         } else {
             polyscene::detect::detect(&cloud, &params).unwrap()
         };

@@ -37,10 +37,11 @@ pub struct MergeEvent {
 ///   `mergeGap` of each other (pieces of one surface that grew together);
 /// - or the smaller one lying over the larger one (three quarters of its
 ///   outline vertices inside the larger's outline, or within `mergeGap` of
-///   it) within the inlier
-///   distance of non-ground planes (`distance`): layers closer than RANSAC
-///   tells planes apart, such as one surface seen again through a pose a
-///   few centimetres off.
+///   it) within twice the inlier distance of non-ground planes
+///   (`Params::layer_distance`): layers closer than RANSAC tells planes
+///   apart, such as one surface seen again through a pose a few
+///   centimetres off. Beyond the inlier distance, half of the smaller's
+///   support must lie where the larger has support too.
 pub fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
     if a.plane.angle_to(&b.plane) > params.merge_angle.to_radians() {
         return false;
@@ -73,12 +74,17 @@ pub fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
     let centroids = a.plane.signed_distance(cb).abs() <= params.merge_distance
         && b.plane.signed_distance(ca).abs() <= params.merge_distance;
     let close = ms.sqrt() <= params.merge_distance || centroids;
-    let layered = !close && ms.sqrt() <= params.other.distance;
+    let layered = !close && ms.sqrt() <= params.layer_distance();
+    // Layers farther apart than the inlier distance are one surface only
+    // where both were seen at the same place, which two real surfaces
+    // cannot be (the nearer hides the farther): a window recessed in a
+    // facade lies where the facade has no support.
+    let seen_twice = ms.sqrt() <= params.other.distance;
     if !close && !layered {
         return false;
     }
     let ((alo, ahi), (blo, bhi)) = (bounds(&av), bounds(&bv));
-    let pad = DVec3::splat(params.merge_gap + params.merge_distance.max(params.other.distance));
+    let pad = DVec3::splat(params.merge_box_pad());
     if (alo - pad).cmpgt(bhi).any() || (blo - pad).cmpgt(ahi).any() {
         return false;
     }
@@ -88,9 +94,24 @@ pub fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
             .map(|&v| big.frame.to_local(v))
             .filter(|&q| contains(&big.outline, q) || distance(&big.outline, q) <= params.merge_gap)
             .count();
-        return 4 * inside >= 3 * small_v.len();
+        return 4 * inside >= 3 * small_v.len() && (seen_twice || seen_on_both(small, big));
     }
     // The outlines, both in a's frame: touching or overlapping?
     let b_in_a: Vec<DVec2> = bv.iter().map(|&v| a.frame.to_local(v)).collect();
     rings_within(&a.outline, &b_in_a, params.merge_gap)
+}
+
+/// Does most of `small`'s support lie where `big` has support too? At
+/// least half of `small`'s footprint cells, mapped into `big`'s frame, land
+/// on a set cell of `big`'s footprint.
+fn seen_on_both(small: &Primitive, big: &Primitive) -> bool {
+    let cells = small.footprint.cell_centres();
+    let on_big = cells
+        .iter()
+        .filter(|&&q| {
+            big.footprint
+                .is_set(big.frame.to_local(small.frame.to_world(q)))
+        })
+        .count();
+    !cells.is_empty() && 2 * on_big >= cells.len()
 }

@@ -317,9 +317,12 @@ mod tests {
     }
 
     /// One wall seen twice through poses 9 cm apart: overlapping layers
-    /// closer than the inlier distance are one surface. 15 cm apart (a
-    /// window recessed in a facade) they stay two, and so does a layer
-    /// beside the wall rather than over it (a step, not a layer).
+    /// closer than the inlier distance are one surface. 15 cm apart they
+    /// are one surface only where both were seen at the same place: a
+    /// window recessed 15 cm in a facade, where the facade has no support,
+    /// stays two, and so does a layer beside the wall rather than over it
+    /// (a step, not a layer). 25 cm apart, beyond twice the inlier
+    /// distance, they stay two.
     #[test]
     fn overlapping_layers_within_the_inlier_distance_merge() {
         let p = Params::gpp2();
@@ -334,7 +337,26 @@ mod tests {
         assert!(mergeable(&prims[0], &prims[1], &p));
         let c = shifted(patch(1.0, 4.0, 0.0, 0.025), 0.15);
         let (prims, _, _) = two(&a, &c, &p);
-        assert!(!mergeable(&prims[0], &prims[1], &p));
+        assert!(mergeable(&prims[0], &prims[1], &p), "seen twice, 15 cm");
+        let c = shifted(patch(1.0, 4.0, 0.0, 0.025), 0.25);
+        let (prims, _, _) = two(&a, &c, &p);
+        assert!(!mergeable(&prims[0], &prims[1], &p), "seen twice, 25 cm");
+        // The facade around a window (x 1-4 m, z 0.5-1.5 m), and the window
+        // 15 cm behind it.
+        let in_window = |q: &Vec3| (0.95..4.05).contains(&q.x) && (0.45..1.55).contains(&q.z);
+        let facade: Vec<Vec3> = a.iter().copied().filter(|q| !in_window(q)).collect();
+        let window: Vec<Vec3> = shifted(patch(1.0, 4.0, 0.0, 0.025), 0.15)
+            .into_iter()
+            .filter(|q| (0.5..1.5).contains(&q.z))
+            .collect();
+        let (prims, _, _) = two(&facade, &window, &p);
+        // The facade's outline has no holes: the window lies inside it.
+        let window_centre = prims[0].frame.to_local(prims[1].moments.mean());
+        assert!(crate::geometry::polygon::contains(
+            &prims[0].outline,
+            window_centre
+        ));
+        assert!(!mergeable(&prims[0], &prims[1], &p), "a recessed window");
         let d = shifted(patch(6.2, 9.0, 0.0, 0.025), 0.09);
         let (prims, _, _) = two(&a, &d, &p);
         assert!(!mergeable(&prims[0], &prims[1], &p));

@@ -285,6 +285,22 @@ impl Params {
         }
     }
 
+    /// How far apart two overlapping near-parallel primitives may lie and
+    /// still be merged as layers of one surface (m): twice the inlier
+    /// distance of non-ground planes, the closest two parallel planes can be
+    /// while one plane between them holds the points of both within the
+    /// inlier distance, so that RANSAC cannot tell them apart.
+    pub(crate) fn layer_distance(&self) -> f64 {
+        2.0 * self.other.distance
+    }
+
+    /// How far apart (m, per axis) the outline boxes of two primitives
+    /// that can merge may be: `mergeGap` plus the larger of `mergeDistance`
+    /// and [`Params::layer_distance`].
+    pub(crate) fn merge_box_pad(&self) -> f64 {
+        self.merge_gap + self.merge_distance.max(self.layer_distance())
+    }
+
     /// Check every option's range (declared in the options table);
     /// the error names the camelCase key. The values are read from the
     /// serde form, where a non-finite number is `null` (and fails every
