@@ -134,12 +134,24 @@ pub fn triangulate_ring(ring: &[DVec2]) -> Option<RingTriangles> {
     if n < 3 {
         return None;
     }
-    let edges: Vec<[usize; 2]> = (0..n).map(|i| [i, (i + 1) % n]).collect();
-    let mut crossing = false;
-    let cdt: ConstrainedDelaunayTriangulation<Point2<f64>> =
-        ConstrainedDelaunayTriangulation::try_bulk_load_cdt(points, edges, |_| crossing = true)
-            .ok()?;
-    if crossing || cdt.num_vertices() < 3 || cdt.num_inner_faces() == 0 {
+    // Built one vertex and one edge at a time, in ring order: spade's bulk
+    // loader re-inserts what it skipped from a hash set with a random
+    // hasher, so the same ring could come out as other triangles (or the
+    // same ones in another order) from one call to the next.
+    let mut cdt: ConstrainedDelaunayTriangulation<Point2<f64>> =
+        ConstrainedDelaunayTriangulation::new();
+    let mut handles = Vec::with_capacity(n);
+    for p in points {
+        handles.push(cdt.insert(p).ok()?);
+    }
+    for i in 0..n {
+        let (from, to) = (handles[i], handles[(i + 1) % n]);
+        // An edge that crosses an earlier one: the ring is not simple.
+        if from != to && cdt.try_add_constraint(from, to).is_empty() {
+            return None;
+        }
+    }
+    if cdt.num_vertices() < 3 || cdt.num_inner_faces() == 0 {
         return None;
     }
     // 0-1 breadth-first search over the inner faces from the outside: crossing
@@ -300,6 +312,38 @@ mod tests {
         let t = triangulate_ring(&ring).unwrap();
         let total: f64 = t.triangles.iter().map(|tr| tri_area(&t.vertices, tr)).sum();
         assert!((total - signed_area(&ring).abs()).abs() < 1e-9);
+    }
+
+    /// The same ring gives the same triangles, in the same order, every
+    /// time (spade's bulk loader did not: it re-inserts the vertices it
+    /// skipped in the order of a randomly seeded hash set).
+    #[test]
+    fn the_same_ring_gives_the_same_triangles_every_time() {
+        let mut rng = crate::rng::Rng::new(5);
+        let mut rings: Vec<Vec<DVec2>> = (0..100)
+            .map(|_| {
+                let n = 3 + rng.below(200);
+                (0..n)
+                    .map(|i| {
+                        let a = std::f64::consts::TAU * (i as f64 + rng.range(0.0, 0.9)) / n as f64;
+                        let r = rng.range(0.2, 5.0);
+                        // On a 5 cm grid, as traced outlines are: many
+                        // collinear and cocircular vertices.
+                        (DVec2::new(r * a.cos(), r * a.sin()) / 0.05).round() * 0.05
+                    })
+                    .collect()
+            })
+            .collect();
+        rings.retain(|r| triangulate_ring(r).is_some());
+        assert!(rings.len() > 50, "{} rings triangulated", rings.len());
+        for ring in &rings {
+            let first = triangulate_ring(ring).unwrap();
+            for _ in 0..3 {
+                let again = triangulate_ring(ring).unwrap();
+                assert_eq!(again.vertices, first.vertices);
+                assert_eq!(again.triangles, first.triangles);
+            }
+        }
     }
 
     #[test]
