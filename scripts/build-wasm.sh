@@ -68,7 +68,7 @@ for d in "${dirs[@]}" www/pkg; do
   done
 done
 if [ "${FORCE:-0}" != 1 ] && [ "$fresh" = 1 ] && [ "$(cat pkg/.inputs.sha256 2>/dev/null)" = "$hash" ]; then
-  echo "build-wasm: pkg/ is up to date ($(paste -sd';' pkg/wasm-size.txt 2>/dev/null || echo 'size unknown'))"
+  echo "build-wasm: pkg/ is up to date ($(awk 'NR > 1 { printf "; " } { printf "%s", $0 }' pkg/wasm-size.txt 2>/dev/null || echo 'size unknown'))"
   check_budget
   exit 0
 fi
