@@ -22,7 +22,7 @@
 //! `polyscene_sim_bg.wasm` (`polyscene/sim`: `simulate`, `Simulation`,
 //! `version`; `scripts/build-wasm.sh` builds it with
 //! `--no-default-features --features wasm-sim`). Each carries only its own
-//! code: the package's detection wasm is 31 kB gzipped smaller without the
+//! code: the package's detection wasm is 32 kB gzipped smaller without the
 //! simulator, and the simulator's has no detection code. Both features
 //! together (the binding tests, `tests/wasm.rs`) give one wasm with both.
 //!
