@@ -26,6 +26,7 @@ const SCANS = arg("scans", 100);
 const REPEAT = arg("repeat", 3);
 
 const ps = createRequire(import.meta.url)(path.join(root, "pkg/node"));
+const psSim = createRequire(import.meta.url)(path.join(root, "pkg/node/polyscene_sim.js"));
 const bin = path.join(process.env.CARGO_TARGET_DIR ?? path.join(root, "target"), "release", "polyscene");
 if (!fs.existsSync(bin)) {
   console.error(`${bin} is missing: cargo build --release --bin polyscene`);
@@ -41,7 +42,7 @@ const tmp = fs.mkdtempSync(path.join(os.tmpdir(), "polyscene-bench-"));
 process.on("exit", () => fs.rmSync(tmp, { recursive: true, force: true }));
 
 // 1. The drive. Scans are simulated before timing.
-const sim = ps.simulate({ layout: "street", seed: 1 });
+const sim = psSim.simulate({ layout: "street", seed: 1 });
 const scans = Array.from({ length: SCANS }, (_, k) => sim.scan(k));
 sim.free();
 // The drive is replayed REPEAT times from a fresh scenario, as the native

@@ -4,9 +4,10 @@
 //! here from that struct's source: the struct's doc comment, then one key per
 //! `pub` field, camelCase, typed from the Rust type (see [`ts_type`]) and
 //! documented with the field's doc comment. `src/wasm/mod.rs` includes the
-//! output (`interfaces.d.ts`) in the `.d.ts`, so the typings cannot drift
-//! from the values the binding builds (the views in `src/wasm/convert.rs`
-//! set their keys by hand: `tests/js/api.test.mjs` compares every object's
+//! output (`interfaces.d.ts`) in the main module's `.d.ts` and
+//! `src/wasm/sim.rs` includes `sim_interfaces.d.ts` in the simulator's, so
+//! the typings cannot drift from the values the binding builds (the views in
+//! `src/wasm/convert.rs` and `src/wasm/sim.rs` set their keys by hand: `tests/js/api.test.mjs` compares every object's
 //! keys with its interface).
 //!
 //! A deliberately small parser: a struct is `pub struct Name {` up to the
@@ -17,8 +18,8 @@ use std::collections::HashMap;
 use std::fs;
 use std::path::Path;
 
-/// Every interface of the `.d.ts` that mirrors a Rust struct, in the order
-/// of the `.d.ts`.
+/// Every interface of the main module's `.d.ts` (`polyscene`) that mirrors a
+/// Rust struct, in the order of the `.d.ts`.
 const INTERFACES: &[Interface] = &[
     Interface {
         ts: "ScenarioOptions",
@@ -38,13 +39,6 @@ const INTERFACES: &[Interface] = &[
         ts: "ScanOptions",
         file: "src/wasm/convert.rs",
         rust: "ScanOptions",
-        optional: true,
-        flatten: &[],
-    },
-    Interface {
-        ts: "SimulateOptions",
-        file: "src/wasm/convert.rs",
-        rust: "SimulateOptions",
         optional: true,
         flatten: &[],
     },
@@ -90,16 +84,28 @@ const INTERFACES: &[Interface] = &[
         optional: false,
         flatten: &[],
     },
+];
+
+/// The same for the simulator's module (`polyscene/sim`, the `wasm-sim`
+/// feature): `src/wasm/sim.rs` includes them from `sim_interfaces.d.ts`.
+const SIM_INTERFACES: &[Interface] = &[
+    Interface {
+        ts: "SimulateOptions",
+        file: "src/wasm/sim.rs",
+        rust: "SimulateOptions",
+        optional: true,
+        flatten: &[],
+    },
     Interface {
         ts: "SimulatedScan",
-        file: "src/wasm/convert.rs",
+        file: "src/wasm/sim.rs",
         rust: "ScanView",
         optional: false,
         flatten: &[],
     },
     Interface {
         ts: "GroundTruthPolygon",
-        file: "src/wasm/convert.rs",
+        file: "src/wasm/sim.rs",
         rust: "GroundTruthView",
         optional: false,
         flatten: &[],
@@ -118,12 +124,18 @@ const STRING_ENUMS: &[StringEnum] = &[
     },
 ];
 
-/// Writes `interfaces.d.ts` (the interfaces of [`INTERFACES`]) into `out`.
+/// Writes `interfaces.d.ts` (the interfaces of [`INTERFACES`]) and
+/// `sim_interfaces.d.ts` (those of [`SIM_INTERFACES`]) into `out`.
 pub fn write(out: &Path) {
     println!("cargo:rerun-if-changed=build/ts_interfaces.rs");
-    let ts = interfaces_ts(INTERFACES, STRING_ENUMS, read_source);
-    if let Err(e) = fs::write(out.join("interfaces.d.ts"), ts) {
-        panic!("cannot write the generated TypeScript: {e}");
+    for (file, interfaces) in [
+        ("interfaces.d.ts", INTERFACES),
+        ("sim_interfaces.d.ts", SIM_INTERFACES),
+    ] {
+        let ts = interfaces_ts(interfaces, STRING_ENUMS, read_source);
+        if let Err(e) = fs::write(out.join(file), ts) {
+            panic!("cannot write the generated TypeScript: {e}");
+        }
     }
 }
 

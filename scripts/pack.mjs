@@ -8,9 +8,12 @@
 //     LICENSE-MIT, LICENSE-APACHE
 //     web/              pkg/web: ES module, init() first; browsers, workers, bundlers
 //       polyscene_inline.js  the same with the wasm inlined (base64): zero bundler config
+//       polyscene_sim.js, polyscene_sim_bg.wasm, polyscene_sim_inline.js
+//                       the same for polyscene/sim (the simulator: a wasm of its own)
 //     node/             pkg/node as polyscene.cjs (ready on require; it reads
 //                       web/polyscene_bg.wasm, the same file), polyscene.mjs (its
-//                       ES module face: one wasm instance for both)
+//                       ES module face: one wasm instance for both); the same
+//                       for polyscene_sim
 //     worker/           www/src/worker.js and client.js (polyscene/worker), index.js
 //     geo/              js/geo.mjs and js/geo.d.mts as index.js, index.d.ts (polyscene/geo;
 //                       the dependency proj4 is for it)
@@ -54,8 +57,17 @@ const field = (name) => cargo.match(new RegExp(`^${name} = "([^"]*)"`, 'm'))?.[1
 const version = field('version');
 const description = field('description');
 
+// The two wasm builds of the crate (scripts/build-wasm.sh): the main module
+// and the simulator's (polyscene/sim), each checked to export what it must.
+const MODULES = [
+  { name: 'polyscene', must: ['Scenario', 'detect'] },
+  { name: 'polyscene_sim', must: ['simulate', 'Simulation'] },
+];
+
 for (const d of ['pkg/web', 'pkg/node']) {
-  if (!fs.existsSync(path.join(root, d, 'polyscene_bg.wasm'))) fail(`${d} is missing: run scripts/build-wasm.sh`);
+  for (const { name } of MODULES) {
+    if (!fs.existsSync(path.join(root, d, `${name}_bg.wasm`))) fail(`${d}/${name}_bg.wasm is missing: run scripts/build-wasm.sh`);
+  }
 }
 
 fs.rmSync(out, { recursive: true, force: true });
@@ -111,22 +123,24 @@ const write = (p, text) => {
   fs.writeFileSync(path.join(out, p), text);
 };
 
-// web/
-write('web/polyscene.js', dedupeFreeJs(read('pkg/web/polyscene.js'), 'pkg/web/polyscene.js'));
-write('web/polyscene.d.ts', fixDts(read('pkg/web/polyscene.d.ts'), 'pkg/web/polyscene.d.ts'));
-fs.copyFileSync(path.join(root, 'pkg/web/polyscene_bg.wasm'), path.join(out, 'web/polyscene_bg.wasm'));
-fs.copyFileSync(path.join(root, 'pkg/web/polyscene_bg.wasm.d.ts'), path.join(out, 'web/polyscene_bg.wasm.d.ts'));
+for (const { name, must } of MODULES) {
+  // web/
+  write(`web/${name}.js`, dedupeFreeJs(read(`pkg/web/${name}.js`), `pkg/web/${name}.js`));
+  write(`web/${name}.d.ts`, fixDts(read(`pkg/web/${name}.d.ts`), `pkg/web/${name}.d.ts`));
+  fs.copyFileSync(path.join(root, `pkg/web/${name}_bg.wasm`), path.join(out, `web/${name}_bg.wasm`));
+  fs.copyFileSync(path.join(root, `pkg/web/${name}_bg.wasm.d.ts`), path.join(out, `web/${name}_bg.wasm.d.ts`));
 
-// web/polyscene_inline.js: the wasm in the JS, so that a bundler needs no
-// asset handling at all (esbuild has no loader for .wasm by default).
-const wasmBase64 = fs.readFileSync(path.join(root, 'pkg/web/polyscene_bg.wasm')).toString('base64');
-write(
-  'web/polyscene_inline.js',
-  `// polyscene/inline: the web build with polyscene_bg.wasm inlined (base64),
+  // web/NAME_inline.js: the wasm in the JS, so that a bundler needs no
+  // asset handling at all (esbuild has no loader for .wasm by default).
+  const wasmBase64 = fs.readFileSync(path.join(root, `pkg/web/${name}_bg.wasm`)).toString('base64');
+  const subpath = name === 'polyscene' ? 'polyscene/inline' : 'polyscene/sim/inline';
+  write(
+    `web/${name}_inline.js`,
+    `// ${subpath}: the web build with ${name}_bg.wasm inlined (base64),
 // for bundlers and pages that should not serve a separate .wasm file. Same
 // exports; init() needs no argument (init({ module_or_path }) still works).
-import initWasm, { initSync as initSyncWasm } from './polyscene.js';
-export * from './polyscene.js';
+import initWasm, { initSync as initSyncWasm } from './${name}.js';
+export * from './${name}.js';
 
 const WASM_BASE64 = '${wasmBase64}';
 
@@ -147,31 +161,31 @@ export function initSync(options) {
   return initSyncWasm({ module: options?.module ?? wasmBytes() });
 }
 `,
-);
+  );
 
-// node/
-const nodeJs = dedupeFreeJs(read('pkg/node/polyscene.js'), 'pkg/node/polyscene.js').replace(
-  '/* @ts-self-types="./polyscene.d.ts" */',
-  '/* @ts-self-types="./polyscene.d.cts" */',
-);
-// The Node build's wasm is the same file as the web build's: one copy, in web/.
-if (!fs.readFileSync(path.join(root, 'pkg/node/polyscene_bg.wasm')).equals(fs.readFileSync(path.join(root, 'pkg/web/polyscene_bg.wasm')))) {
-  fail('pkg/node and pkg/web have different polyscene_bg.wasm files');
-}
-const wasmPathLine = 'const wasmPath = `${__dirname}/polyscene_bg.wasm`;';
-if (!nodeJs.includes(wasmPathLine)) fail(`pkg/node/polyscene.js does not read the wasm with ${wasmPathLine}`);
-write('node/polyscene.cjs', nodeJs.replace(wasmPathLine, "const wasmPath = require('path').join(__dirname, '..', 'web', 'polyscene_bg.wasm');"));
-write('node/polyscene.d.cts', fixDts(read('pkg/node/polyscene.d.ts'), 'pkg/node/polyscene.d.ts'));
-const names = Object.keys(createRequire(import.meta.url)(path.join(out, 'node/polyscene.cjs'))).sort();
-if (!names.includes('Scenario') || !names.includes('detect')) fail(`node/polyscene.cjs exports ${names.join(', ')}`);
-write(
-  'node/polyscene.mjs',
-  `// Node's ES module entry of polyscene: the CommonJS build (ready on import;
-// it reads polyscene_bg.wasm from disk) under ES module names, so that
+  // node/
+  const nodeJs = dedupeFreeJs(read(`pkg/node/${name}.js`), `pkg/node/${name}.js`).replace(
+    `/* @ts-self-types="./${name}.d.ts" */`,
+    `/* @ts-self-types="./${name}.d.cts" */`,
+  );
+  // The Node build's wasm is the same file as the web build's: one copy, in web/.
+  if (!fs.readFileSync(path.join(root, `pkg/node/${name}_bg.wasm`)).equals(fs.readFileSync(path.join(root, `pkg/web/${name}_bg.wasm`)))) {
+    fail(`pkg/node and pkg/web have different ${name}_bg.wasm files`);
+  }
+  const wasmPathLine = `const wasmPath = \`\${__dirname}/${name}_bg.wasm\`;`;
+  if (!nodeJs.includes(wasmPathLine)) fail(`pkg/node/${name}.js does not read the wasm with ${wasmPathLine}`);
+  write(`node/${name}.cjs`, nodeJs.replace(wasmPathLine, `const wasmPath = require('path').join(__dirname, '..', 'web', '${name}_bg.wasm');`));
+  write(`node/${name}.d.cts`, fixDts(read(`pkg/node/${name}.d.ts`), `pkg/node/${name}.d.ts`));
+  const names = Object.keys(createRequire(import.meta.url)(path.join(out, `node/${name}.cjs`))).sort();
+  if (!must.every((n) => names.includes(n))) fail(`node/${name}.cjs exports ${names.join(', ')}`);
+  write(
+    `node/${name}.mjs`,
+    `// Node's ES module entry of ${name}: the CommonJS build (ready on import;
+// it reads ${name}_bg.wasm from disk) under ES module names, so that
 // import and require share one wasm instance. Generated by scripts/pack.mjs.
 import { createRequire } from 'node:module';
 
-const cjs = createRequire(import.meta.url)('./polyscene.cjs');
+const cjs = createRequire(import.meta.url)('./${name}.cjs');
 
 export const { ${names.join(', ')} } = cjs;
 
@@ -180,23 +194,26 @@ export default async function init() {
   return undefined;
 }
 `,
-);
-write(
-  'node/polyscene.d.mts',
-  `export * from "./polyscene.cjs";
+  );
+  write(
+    `node/${name}.d.mts`,
+    `export * from "./${name}.cjs";
 
 /** Nothing to wait for in Node; here so that code written for the web build (\`await init()\`) runs unchanged. */
 export default function init(options?: unknown): Promise<void>;
 `,
-);
+  );
+}
 
-// worker/: the page's worker and client; only the path to the web build differs.
+// worker/: the page's worker and client; only the paths to the web builds differ.
 for (const f of ['worker.js', 'client.js']) {
   let text = read(`www/src/${f}`);
   if (f === 'worker.js') {
-    const from = "from '../pkg/polyscene.js';";
-    if (!text.includes(from)) fail(`www/src/worker.js does not import ${from}`);
-    text = text.replace(from, "from '../web/polyscene.js';");
+    for (const { name } of MODULES) {
+      const from = `from '../pkg/${name}.js';`;
+      if (!text.includes(from)) fail(`www/src/worker.js does not import ${from}`);
+      text = text.replace(from, `from '../web/${name}.js';`);
+    }
   }
   write(`worker/${f}`, text);
 }

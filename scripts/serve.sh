@@ -9,10 +9,12 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 PORT="${1:-${PORT:-8080}}"
 
-if [ ! -f www/pkg/polyscene.js ] || [ ! -f www/pkg/polyscene_bg.wasm ]; then
-  echo "serve: www/pkg/polyscene.js or polyscene_bg.wasm is missing; run scripts/build-wasm.sh (or make demo) first" >&2
-  exit 1
-fi
+for f in polyscene.js polyscene_bg.wasm polyscene_sim.js polyscene_sim_bg.wasm; do
+  if [ ! -f "www/pkg/$f" ]; then
+    echo "serve: www/pkg/$f is missing; run scripts/build-wasm.sh (or make demo) first" >&2
+    exit 1
+  fi
+done
 if [ ! -f www/node_modules/three/build/three.module.js ] || [ ! -f www/node_modules/lil-gui/dist/lil-gui.esm.js ] ||
   [ ! -f www/node_modules/maplibre-gl/dist/maplibre-gl.mjs ] || [ ! -f www/node_modules/proj4/dist/proj4-src.js ]; then
   echo "serve: www/node_modules is incomplete; run scripts/setup.sh npm (or make demo) first" >&2

@@ -7,8 +7,15 @@ use std::sync::OnceLock;
 
 static CLOCK: OnceLock<fn() -> f64> = OnceLock::new();
 
-/// Install the millisecond clock (first call wins).
-#[cfg_attr(not(target_arch = "wasm32"), allow(dead_code))]
+/// Install the millisecond clock (first call wins). Only the JS binding
+/// calls it (wasm32 builds with a binding feature).
+#[cfg_attr(
+    not(all(
+        target_arch = "wasm32",
+        any(feature = "wasm-main", feature = "wasm-sim")
+    )),
+    allow(dead_code)
+)]
 pub fn install(now_ms: fn() -> f64) {
     let _ = CLOCK.set(now_ms);
 }

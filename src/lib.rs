@@ -26,7 +26,11 @@ pub mod params;
 pub mod primitive;
 pub mod scenario;
 pub mod sim;
-#[cfg(target_arch = "wasm32")]
+// The JS binding, in wasm32 builds with either of its features (Cargo.toml).
+#[cfg(all(
+    target_arch = "wasm32",
+    any(feature = "wasm-main", feature = "wasm-sim")
+))]
 pub mod wasm;
 
 mod clock;

@@ -1,12 +1,15 @@
 //! The binding layer (`src/wasm/`) under Node: `wasm-pack test --node --
 //! --test wasm`. Options parsing, errors as JS `Error`s naming the problem,
 //! a small detection, the scenario's conversions. (The package as a whole is
-//! tested by `node --test tests/js/`.)
-#![cfg(target_arch = "wasm32")]
+//! tested by `node --test tests/js/`.) With `--features wasm-sim` (as
+//! `scripts/test-js.sh` runs it) the simulator's binding is tested too.
+#![cfg(all(target_arch = "wasm32", feature = "wasm-main"))]
 
 use js_sys::{Array, Float32Array, Float64Array, Reflect, Uint32Array, JSON};
 use polyscene::params::Params;
-use polyscene::wasm::{default_options, detect, simulate, Failure, JsScenario};
+#[cfg(feature = "wasm-sim")]
+use polyscene::wasm::simulate;
+use polyscene::wasm::{default_options, detect, Failure, JsScenario};
 use wasm_bindgen::prelude::*;
 use wasm_bindgen::JsCast;
 use wasm_bindgen_test::wasm_bindgen_test;
@@ -174,6 +177,9 @@ fn a_scenario_takes_scans_with_poses_and_refuses_bad_ones() {
     assert!(m.contains("Scenario was freed"), "{m}");
 }
 
+/// The simulator's binding (its own wasm in the package; here with
+/// `--features wasm-sim`, as scripts/test-js.sh runs it).
+#[cfg(feature = "wasm-sim")]
 #[wasm_bindgen_test]
 fn the_simulator_runs() {
     let sim = simulate(Some(json(

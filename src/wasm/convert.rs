@@ -17,16 +17,21 @@
 use super::error::{bad_option, invalid, Failure, WasmResult};
 use super::js::{self, describe};
 use crate::cloud::check_rigid;
-use crate::cloud::{Cloud, Coordinates, MAX_POINTS};
 use crate::error::{Error, Result};
-use crate::mesh::Mesh;
-use crate::params::Params;
-use crate::primitive::Primitive;
-use crate::sim::{DriveOptions, GtPolygon, Layout, Scan, SurfaceKind};
 use glam::{DMat4, DVec3};
-use js_sys::{Array, ArrayBuffer, Float32Array, Float64Array, Object, Reflect, Uint32Array, JSON};
+use js_sys::{Array, ArrayBuffer, Float64Array, Object, Reflect};
 use serde_json::{Map, Value};
 use wasm_bindgen::prelude::*;
+// What only the detection binding reads and returns (the `wasm-main` feature).
+#[cfg(feature = "wasm-main")]
+use crate::{
+    cloud::{Cloud, Coordinates, MAX_POINTS},
+    mesh::Mesh,
+    params::Params,
+    primitive::Primitive,
+};
+#[cfg(feature = "wasm-main")]
+use js_sys::{Float32Array, Uint32Array, JSON};
 
 /// Largest integer a JS number holds exactly (2^53 - 1).
 pub(crate) const MAX_SAFE_INTEGER: f64 = 9_007_199_254_740_991.0;
@@ -40,12 +45,14 @@ pub type Stride = usize;
 /// A world-from-sensor pose as the binding reads it (see [`pose_of`]).
 pub type Pose = DMat4;
 
+#[cfg(feature = "wasm-main")]
 /// Options of `new Scenario(options)`: the pipeline options.
 pub struct ScenarioOptions {
     /// The pipeline options (flattened: `PipelineOptions`).
     pub params: Params,
 }
 
+#[cfg(feature = "wasm-main")]
 /// Options of `detect(points, options)`: the pipeline options plus the point layout.
 pub struct DetectOptions {
     /// The pipeline options (flattened: `PipelineOptions`).
@@ -54,6 +61,7 @@ pub struct DetectOptions {
     pub stride: Stride,
 }
 
+#[cfg(feature = "wasm-main")]
 /// Options of `scenario.addScan(points, options)`.
 pub struct ScanOptions {
     /// Numbers per point: 3 (x, y, z) or 4 (x, y, z, intensity). Default 3.
@@ -64,35 +72,23 @@ pub struct ScanOptions {
     pub pose: Pose,
 }
 
-/// Options of `simulate(options)`.
-pub struct SimulateOptions {
-    /// Scene layout. Default "street".
-    pub layout: Layout,
-    /// Seed of the scene and of the sensor noise. Default 1. Integer in [0, 2^53).
-    pub seed: u64,
-    /// Distance driven between scans (m). Default 1.0 (10 m/s at 10 Hz). Range [0.05, 10].
-    pub step: f64,
-    /// World position of the scene's origin (m), to test far-from-origin coordinates. Default [0, 0, 0].
-    pub origin: DVec3,
-}
-
 /// The keys a call reads from its options object.
-struct Keys {
+pub(super) struct Keys {
     /// The object's name in messages ("detect options").
-    what: &'static str,
+    pub(super) what: &'static str,
     /// The call's own keys, taken out of the pipeline options: `stride`
     /// (checked as read), `pose` (read as a pose), others (left as JSON).
-    own: &'static [&'static str],
+    pub(super) own: &'static [&'static str],
     /// `None`: the pipeline options are read too (`Params::from_options`
     /// judges the other keys); `Some(reason)`: any other key is refused at
     /// once with this reason.
-    closed: Option<&'static str>,
+    pub(super) closed: Option<&'static str>,
 }
 
 /// An options object as read by [`read_options`].
-struct Read {
+pub(super) struct Read {
     /// The JSON values of the keys other than `stride` and `pose`.
-    map: Map<String, Value>,
+    pub(super) map: Map<String, Value>,
     /// `stride`, default 3.
     stride: Stride,
     /// `pose`, default identity.
@@ -113,7 +109,7 @@ const MAX_OPTION_NUMBERS: usize = 64;
 /// a value JSON cannot hold, a bad `stride` or `pose`. Whatever the object's
 /// getters or Proxy traps throw becomes an `Error` naming the key, with the
 /// thrown value as `cause`.
-fn read_options(v: &JsValue, keys: &Keys) -> WasmResult<Read> {
+pub(super) fn read_options(v: &JsValue, keys: &Keys) -> WasmResult<Read> {
     let mut read = Read {
         map: Map::new(),
         stride: 3,
@@ -174,6 +170,7 @@ fn read_options(v: &JsValue, keys: &Keys) -> WasmResult<Read> {
     Ok(read)
 }
 
+#[cfg(feature = "wasm-main")]
 impl ScenarioOptions {
     /// Read `new Scenario(options)`'s options.
     pub(crate) fn from_js(v: &JsValue) -> WasmResult<Self> {
@@ -191,6 +188,7 @@ impl ScenarioOptions {
     }
 }
 
+#[cfg(feature = "wasm-main")]
 impl DetectOptions {
     /// Read `detect(points, options)`'s options.
     pub(crate) fn from_js(v: &JsValue) -> WasmResult<Self> {
@@ -209,6 +207,7 @@ impl DetectOptions {
     }
 }
 
+#[cfg(feature = "wasm-main")]
 impl ScanOptions {
     /// Read `scenario.addScan(points, options)`'s options.
     pub(crate) fn from_js(v: &JsValue) -> WasmResult<Self> {
@@ -224,68 +223,6 @@ impl ScanOptions {
             stride: read.stride,
             pose: read.pose,
         })
-    }
-}
-
-impl SimulateOptions {
-    /// Read `simulate(options)`'s options.
-    pub(crate) fn from_js(v: &JsValue) -> WasmResult<Self> {
-        let mut map = read_options(
-            v,
-            &Keys {
-                what: "simulate options",
-                own: &["layout", "seed", "step", "origin"],
-                closed: Some("unknown option; simulate takes layout, seed, step and origin"),
-            },
-        )?
-        .map;
-        let layout = match map.remove("layout") {
-            None => Layout::Street,
-            Some(Value::String(s)) => s.parse()?,
-            Some(other) => {
-                return Err(bad_option(
-                    "layout",
-                    format!("expected 'street' or 'crossing', got {other}"),
-                )
-                .into())
-            }
-        };
-        let seed = match map.remove("seed") {
-            None => 1,
-            Some(v) => v.as_u64().ok_or_else(|| {
-                bad_option("seed", format!("expected a non-negative integer, got {v}"))
-            })?,
-        };
-        let defaults = DriveOptions::default();
-        let step = match map.remove("step") {
-            None => defaults.step,
-            Some(v) => v
-                .as_f64()
-                .ok_or_else(|| bad_option("step", format!("expected a number, got {v}")))?,
-        };
-        let origin = match map.remove("origin") {
-            None => defaults.origin,
-            Some(v) => {
-                let o: Option<[f64; 3]> = serde_json::from_str(&v.to_string()).ok();
-                DVec3::from_array(o.ok_or_else(|| {
-                    bad_option("origin", format!("expected an array of 3 numbers, got {v}"))
-                })?)
-            }
-        };
-        Ok(SimulateOptions {
-            layout,
-            seed,
-            step,
-            origin,
-        })
-    }
-
-    /// The drive's options.
-    pub(crate) fn drive(&self) -> DriveOptions {
-        DriveOptions {
-            step: self.step,
-            origin: self.origin,
-        }
     }
 }
 
@@ -462,8 +399,12 @@ fn json_value(key: &str, v: &JsValue) -> WasmResult<Value> {
     }) {
         Ok(nums) => nums,
         Err(NumbersError::Failed(f)) => return Err(f),
-        Err(NumbersError::NotNumber(i, _)) => {
-            return Err(bad_option(key, format!("element {i} is not a number")).into())
+        Err(NumbersError::NotNumber(i, x)) => {
+            return Err(bad_option(
+                key,
+                format!("element {i} is not a number (got {})", describe(&x)),
+            )
+            .into())
         }
         Err(NumbersError::NotArray) => {
             return Err(bad_option(
@@ -504,6 +445,7 @@ fn json_number(key: &str, x: f64) -> Result<Value> {
     Ok(Value::from(x))
 }
 
+#[cfg(feature = "wasm-main")]
 /// Interleaved points, `stride` numbers each: a `Float32Array` (copied once
 /// into wasm memory) stays f32; a `Float64Array` or `Array` of numbers stays
 /// f64, re-centred in f64 by the core before anything becomes f32 (map
@@ -542,6 +484,7 @@ pub(crate) fn points_of(v: &JsValue, stride: Stride) -> WasmResult<Coordinates> 
     }
 }
 
+#[cfg(feature = "wasm-main")]
 /// The cloud and the parameters of a one-shot detection call (`detect`,
 /// `detectFlat`, `detectWithProgress`): the options first (they give the
 /// stride), then the points, read as [`points_of`] reads them.
@@ -600,6 +543,7 @@ impl<const N: u32> From<Exactly<N>> for JsValue {
     }
 }
 
+#[cfg(feature = "wasm-main")]
 /// A planar polygon of the map (or of one detection).
 pub struct PolygonView {
     /// Stable id: kept while the polygon grows or absorbs another.
@@ -624,6 +568,7 @@ pub struct PolygonView {
     pub last_scan: u64,
 }
 
+#[cfg(feature = "wasm-main")]
 impl PolygonView {
     fn of(p: &Primitive) -> Self {
         PolygonView {
@@ -670,6 +615,7 @@ impl PolygonView {
     }
 }
 
+#[cfg(feature = "wasm-main")]
 /// The polygons triangulated for WebGL.
 pub struct MeshView {
     /// Vertex x, y, z relative to `origin` (m).
@@ -682,6 +628,7 @@ pub struct MeshView {
     pub origin: DVec3,
 }
 
+#[cfg(feature = "wasm-main")]
 impl MeshView {
     fn of(m: &Mesh) -> Self {
         MeshView {
@@ -708,113 +655,22 @@ impl MeshView {
     }
 }
 
-/// One simulated scan.
-pub struct ScanView {
-    /// Scan number.
-    pub index: usize,
-    /// x, y, z, intensity per point (sensor frame, m; intensity in [0, 1]).
-    pub points: Float32Array,
-    /// Always 4.
-    pub stride: Exactly<4>,
-    /// World-from-sensor pose, column-major 4x4, ready for `addScan`.
-    pub pose: Float64Array,
-    /// Per point: the id of the ground-truth polygon it lies on, or 0xFFFFFFFF (clutter).
-    pub labels: Uint32Array,
-}
-
-impl ScanView {
-    fn of(index: usize, scan: &Scan) -> Self {
-        ScanView {
-            index,
-            points: Float32Array::from(&scan.points[..]),
-            stride: Exactly,
-            pose: Float64Array::from(&scan.pose.to_cols_array()[..]),
-            labels: Uint32Array::from(&scan.labels[..]),
-        }
-    }
-
-    fn into_object(self) -> Object {
-        let ScanView {
-            index,
-            points,
-            stride,
-            pose,
-            labels,
-        } = self;
-        let o = Object::new();
-        set(&o, "index", index as f64);
-        set(&o, "points", points);
-        set(&o, "stride", stride);
-        set(&o, "pose", pose);
-        set(&o, "labels", labels);
-        o
-    }
-}
-
-/// A ground-truth polygon of a simulated scene.
-pub struct GroundTruthView {
-    /// Dense id; the point label of hits on it.
-    pub id: u32,
-    /// What the surface is.
-    pub kind: SurfaceKind,
-    /// Unit normal [x, y, z], facing the open side.
-    pub normal: DVec3,
-    /// Plane offset d in normal . x + d = 0 (m).
-    pub offset: f64,
-    /// Outline x, y, z (world, m), interleaved, counter-clockwise seen from the normal side.
-    pub vertices: Float64Array,
-    /// Area (m^2).
-    pub area: f64,
-}
-
-impl GroundTruthView {
-    fn of(g: &GtPolygon) -> Self {
-        let plane = g.polygon.plane();
-        GroundTruthView {
-            id: g.id,
-            kind: g.kind,
-            normal: plane.normal,
-            offset: plane.offset,
-            vertices: flat_vertices(&g.polygon.vertices()),
-            area: g.polygon.area(),
-        }
-    }
-
-    fn into_object(self) -> Object {
-        let GroundTruthView {
-            id,
-            kind,
-            normal,
-            offset,
-            vertices,
-            area,
-        } = self;
-        let o = Object::new();
-        set(&o, "id", id);
-        set(&o, "kind", kind.as_str());
-        set(&o, "normal", vec3(normal));
-        set(&o, "offset", offset);
-        set(&o, "vertices", vertices);
-        set(&o, "area", area);
-        o
-    }
-}
-
 /// Set a property of a fresh plain object.
 pub(crate) fn set(obj: &Object, key: &str, value: impl Into<JsValue>) {
     // Setting a property on a fresh plain object cannot fail.
     let _ = Reflect::set(obj, &key.into(), &value.into());
 }
 
-fn vec3(v: DVec3) -> Array {
+pub(super) fn vec3(v: DVec3) -> Array {
     Array::of3(&v.x.into(), &v.y.into(), &v.z.into())
 }
 
-fn flat_vertices(verts: &[DVec3]) -> Float64Array {
+pub(super) fn flat_vertices(verts: &[DVec3]) -> Float64Array {
     let flat: Vec<f64> = verts.iter().flat_map(|v| v.to_array()).collect();
     Float64Array::from(&flat[..])
 }
 
+#[cfg(feature = "wasm-main")]
 /// The primitives as `Polygon` objects.
 pub(crate) fn polygons_array(prims: &[Primitive]) -> Array {
     prims
@@ -823,24 +679,13 @@ pub(crate) fn polygons_array(prims: &[Primitive]) -> Array {
         .collect()
 }
 
+#[cfg(feature = "wasm-main")]
 /// The mesh as a `Mesh` object.
 pub(crate) fn mesh_object(m: &Mesh) -> Object {
     MeshView::of(m).into_object()
 }
 
-/// Scan `index` as a `SimulatedScan` object.
-pub(crate) fn scan_object(index: usize, scan: &Scan) -> Object {
-    ScanView::of(index, scan).into_object()
-}
-
-/// The ground-truth polygons as `GroundTruthPolygon` objects.
-pub(crate) fn ground_truth_array(polygons: &[GtPolygon]) -> Array {
-    polygons
-        .iter()
-        .map(|g| GroundTruthView::of(g).into_object())
-        .collect()
-}
-
+#[cfg(feature = "wasm-main")]
 /// A serialisable value as a plain JS object, through JSON text (the serde
 /// code is shared with snapshots, which keeps the wasm small).
 pub(crate) fn to_js<T: serde::Serialize>(value: &T) -> WasmResult<JsValue> {

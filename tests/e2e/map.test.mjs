@@ -27,6 +27,7 @@ const require = createRequire(path.join(WWW, 'package.json'));
 const { chromium } = require('playwright-core');
 const { startServer } = await import(pathToFileURL(path.join(WWW, 'tools/static-server.mjs')).href);
 const ps = createRequire(import.meta.url)(path.join(ROOT, 'pkg/node'));
+const psSim = createRequire(import.meta.url)(path.join(ROOT, 'pkg/node/polyscene_sim.js'));
 
 const VIEW = { width: 1280, height: 800 };
 
@@ -75,7 +76,7 @@ before(async () => {
   scratch = mkdtempSync(path.join(os.tmpdir(), 'polyscene-map-e2e-'));
 
   // The snapshot and its known polygon, from the Node package.
-  const sim = ps.simulate({ seed: 1 });
+  const sim = psSim.simulate({ seed: 1 });
   const s = new ps.Scenario({ preset: 'gpp2' });
   for (let k = 0; k < 5; k++) {
     const scan = sim.scan(k);
@@ -290,7 +291,7 @@ test('a LAS with its CRS on the map (polyscene/io): the frame becomes EPSG:32632
 
 test('KITTI scans with camera poses and calib.txt on the map (polyscene/io): the vehicle at the LiDAR positions', { timeout: 60_000 }, async () => {
   const fx = await import(pathToFileURL(path.join(ROOT, 'tests/js/io-fixtures.mjs')).href);
-  const sim = ps.simulate({ layout: 'street', seed: 2 });
+  const sim = psSim.simulate({ layout: 'street', seed: 2 });
   const dir = path.join(scratch, 'kitti');
   mkdirSync(dir, { recursive: true });
   const tr = fx.calibTr();

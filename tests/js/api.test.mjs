@@ -5,23 +5,51 @@ import assert from "node:assert/strict";
 import fs from "node:fs";
 import path from "node:path";
 import { Worker } from "node:worker_threads";
-import { ps, repoRoot } from "./common.mjs";
+import { ps, psSim, repoRoot } from "./common.mjs";
 import { optionDocs, documentedDefault, sameValue, optionsTable } from "../../scripts/gen-js-docs.mjs";
 
 const POLYGON_KEYS = ["id", "normal", "offset", "vertices", "area", "support", "density", "ground", "bornScan", "lastScan"];
 const REPORT_KEYS = ["scan", "points", "explainedByExpansion", "sentToDetection", "explainedByDetection", "poolToDetection", "explainedFromPool", "poolPoints", "added", "grown", "merged", "polygonCount", "totalArea", "timeMs"];
 
-test("exports", () => {
-  for (const name of ["Scenario", "Simulation", "ScanIterator", "detect", "simulate", "defaultOptions", "version"]) {
+test("exports: the simulator in its own module (polyscene/sim), not in the main one", () => {
+  for (const name of ["Scenario", "detect", "detectFlat", "detectWithProgress", "defaultOptions", "version"]) {
     assert.ok(name in ps, name);
   }
-  assert.ok(!("start" in ps), "the start function is private");
+  for (const name of ["Simulation", "ScanIterator", "simulate"]) {
+    assert.ok(!(name in ps), `${name} is not in the main module`);
+    assert.ok(name in psSim, `${name} is in polyscene_sim`);
+  }
+  assert.deepEqual(Object.keys(psSim).sort(), ["ScanIterator", "Simulation", "simulate", "version"]);
+  for (const m of [ps, psSim]) assert.ok(!("start" in m), "the start function is private");
   assert.equal(ps.version(), JSON.parse(JSON.stringify(ps.version())));
   assert.match(ps.version(), /^\d+\.\d+\.\d+/);
+  assert.equal(psSim.version(), ps.version());
+});
+
+test("a simulated scan is JS-owned: it outlives its Simulation and goes into the main module's Scenario (two wasm instances)", () => {
+  const sim = psSim.simulate({ layout: "crossing", seed: 4 });
+  const scan = sim.scan(3);
+  const copy = { points: scan.points.slice(), pose: scan.pose.slice(), labels: scan.labels.slice() };
+  sim.free();
+  // More simulation in the simulator's memory, detection in the other's.
+  const other = psSim.simulate({ layout: "street", seed: 9 });
+  for (let k = 0; k < 3; k++) other.next();
+  other.free();
+  assert.deepEqual(scan.points, copy.points, "points unchanged");
+  assert.deepEqual(scan.pose, copy.pose, "pose unchanged");
+  assert.deepEqual(scan.labels, copy.labels, "labels unchanged");
+  const [a, b] = [new ps.Scenario({ seed: 3 }), new ps.Scenario({ seed: 3 })];
+  const ra = a.addScan(scan.points, { stride: scan.stride, pose: scan.pose });
+  const rb = b.addScan(copy.points, { stride: 4, pose: copy.pose });
+  assert.ok(ra.polygonCount > 5, `${ra.polygonCount} polygons`);
+  assert.deepEqual(a.polygons(), b.polygons(), "the same polygons as from a copy");
+  assert.equal(ra.polygonCount, rb.polygonCount);
+  a.free();
+  b.free();
 });
 
 test("reports, polygons and labels of a street drive", () => {
-  const sim = ps.simulate({ layout: "street", seed: 1 });
+  const sim = psSim.simulate({ layout: "street", seed: 1 });
   const scenario = new ps.Scenario({ preset: "gpp2", hull: "concave", seed: 7 });
   assert.equal(scenario.scans, 0);
   assert.deepEqual(scenario.lastLabels(), new Uint32Array(0));
@@ -75,7 +103,7 @@ test("reports, polygons and labels of a street drive", () => {
 });
 
 test("simulate: next(), scan(k), iteration, reset, ground truth, origin", () => {
-  const sim = ps.simulate({ layout: "street", seed: 2, step: 10 });
+  const sim = psSim.simulate({ layout: "street", seed: 2, step: 10 });
   assert.equal(sim.layout, "street");
   assert.equal(sim.seed, 2);
   assert.ok(sim.length >= 15 && sim.length <= 30, `${sim.length} scans`);
@@ -118,7 +146,7 @@ test("simulate: next(), scan(k), iteration, reset, ground truth, origin", () => 
   });
   assert.ok(gt.some((g) => g.kind === "road"));
   // Scene origin far away: the poses move, the sensor-frame points do not.
-  const far = ps.simulate({ layout: "street", seed: 2, step: 10, origin: [500_000, 4_500_000, 50] });
+  const far = psSim.simulate({ layout: "street", seed: 2, step: 10, origin: [500_000, 4_500_000, 50] });
   const s0 = far.scan(0);
   assert.deepEqual(s0.points, first.points);
   assert.equal(s0.pose[12], first.pose[12] + 500_000);
@@ -128,8 +156,8 @@ test("simulate: next(), scan(k), iteration, reset, ground truth, origin", () => 
 });
 
 test("a Scenario far from the origin gives the same polygons, moved", () => {
-  const near = ps.simulate({ seed: 6 });
-  const far = ps.simulate({ seed: 6, origin: [500_000, 4_500_000, 50] });
+  const near = psSim.simulate({ seed: 6 });
+  const far = psSim.simulate({ seed: 6, origin: [500_000, 4_500_000, 50] });
   const [a, b] = [new ps.Scenario(), new ps.Scenario()];
   for (let k = 0; k < 3; k++) {
     const s = near.scan(k);
@@ -149,7 +177,12 @@ test("a Scenario far from the origin gives the same polygons, moved", () => {
 });
 
 test("the .d.ts interfaces have the objects' keys and typed arrays (both come from one Rust struct)", () => {
-  const dts = fs.readFileSync(path.join(repoRoot, "pkg/node/polyscene.d.ts"), "utf8");
+  const read = (name) => fs.readFileSync(path.join(repoRoot, `pkg/node/${name}.d.ts`), "utf8");
+  const [main, simDts] = [read("polyscene"), read("polyscene_sim")];
+  for (const name of ["SimulatedScan", "GroundTruthPolygon", "SimulateOptions", "SimulationStep"]) {
+    assert.ok(!main.includes(` ${name} `), `${name} is not declared by the main module`);
+  }
+  const dts = `${main}\n${simDts}`;
   /** key -> type of `interface name` in the .d.ts. */
   const declared = (name) => {
     const start = dts.indexOf(`export interface ${name} `);
@@ -168,7 +201,7 @@ test("the .d.ts interfaces have the objects' keys and typed arrays (both come fr
       }
     }
   };
-  const sim = ps.simulate({ seed: 3 });
+  const sim = psSim.simulate({ seed: 3 });
   const scan = sim.scan(0);
   check("SimulatedScan", scan);
   check("GroundTruthPolygon", sim.groundTruth()[0]);
@@ -209,14 +242,21 @@ test("docs/API.md's options table is current (node scripts/gen-js-docs.mjs)", ()
   assert.ok(readme.includes(optionsTable()), "regenerate it with: node scripts/gen-js-docs.mjs");
 });
 
-test("the web build (ES module, pkg/web) runs in a worker thread, without window", async () => {
-  const wasm = path.join(repoRoot, "pkg/web/polyscene_bg.wasm");
-  const url = new URL(`file://${path.join(repoRoot, "pkg/web/polyscene.js")}`).href;
+test("the web build (ES modules, pkg/web) runs in a worker thread, without window; the simulator's scans go into the other wasm's Scenario", async () => {
+  const file = (name) => path.join(repoRoot, "pkg/web", name);
+  const workerData = {
+    url: new URL(`file://${file("polyscene.js")}`).href,
+    wasm: file("polyscene_bg.wasm"),
+    simUrl: new URL(`file://${file("polyscene_sim.js")}`).href,
+    simWasm: file("polyscene_sim_bg.wasm"),
+  };
   const code = `
     import { parentPort, workerData } from "node:worker_threads";
     import fs from "node:fs";
-    const { default: init, Scenario, detect, simulate } = await import(workerData.url);
+    const { default: init, Scenario, detect } = await import(workerData.url);
+    const { default: initSim, simulate } = await import(workerData.simUrl);
     await init({ module_or_path: fs.readFileSync(workerData.wasm) });
+    await initSim({ module_or_path: fs.readFileSync(workerData.simWasm) });
     if (typeof window !== "undefined") throw new Error("window exists");
     const sim = simulate({ seed: 1 });
     const { points, pose } = sim.next();
@@ -226,7 +266,7 @@ test("the web build (ES module, pkg/web) runs in a worker thread, without window
       );
   `;
   const result = await new Promise((resolve, reject) => {
-    const w = new Worker(new URL(`data:text/javascript,${encodeURIComponent(code)}`), { workerData: { url, wasm } });
+    const w = new Worker(new URL(`data:text/javascript,${encodeURIComponent(code)}`), { workerData });
     w.once("message", resolve);
     w.once("error", reject);
   });

@@ -17,6 +17,8 @@ if (!fs.existsSync(path.join(pkgDir, "polyscene_bg.wasm"))) {
 }
 /** The package under test. */
 export const ps = createRequire(import.meta.url)(pkgDir);
+/** The simulator's module of the package (polyscene/sim: a wasm of its own). */
+export const psSim = createRequire(import.meta.url)(path.join(pkgDir, "polyscene_sim.js"));
 
 /** The native CLI (built by scripts/test-js.sh with cargo build --release). */
 export function cli(...args) {

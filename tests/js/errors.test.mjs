@@ -2,7 +2,7 @@
 // the module keeps working afterwards.
 import { test } from "node:test";
 import assert from "node:assert/strict";
-import { ps, throwsError, floor } from "./common.mjs";
+import { ps, psSim, throwsError, floor } from "./common.mjs";
 
 const VIEW = { viewpoint: [5, 5, 1.8] };
 
@@ -133,7 +133,7 @@ test("use after free() says the object was freed", () => {
     throwsError(assert, call, /Scenario was freed/);
   }
   s.free(); // a second free() does nothing
-  const sim = ps.simulate();
+  const sim = psSim.simulate();
   const it = sim[Symbol.iterator]();
   sim.free();
   for (const call of [() => sim.next(), () => sim.scan(0), () => sim.length, () => sim.groundTruth(), () => sim.reset(), () => [...sim]]) {
@@ -181,13 +181,13 @@ test("bad snapshots", () => {
 });
 
 test("simulate: options and ranges", () => {
-  throwsError(assert, () => ps.simulate({ layout: "forest" }), /option 'layout'/, /street/);
-  throwsError(assert, () => ps.simulate({ layout: 1 }), /option 'layout'/);
-  throwsError(assert, () => ps.simulate({ seed: -2 }), /option 'seed'/);
-  throwsError(assert, () => ps.simulate({ step: 0 }), /option 'step'/, /0\.05/);
-  throwsError(assert, () => ps.simulate({ origin: [1, 2] }), /option 'origin'/, /3 numbers/);
-  throwsError(assert, () => ps.simulate({ lenght: 3 }), /option 'lenght'/, /layout, seed, step and origin/);
-  const sim = ps.simulate({ layout: "crossing", seed: 2, step: 5 });
+  throwsError(assert, () => psSim.simulate({ layout: "forest" }), /option 'layout'/, /street/);
+  throwsError(assert, () => psSim.simulate({ layout: 1 }), /option 'layout'/);
+  throwsError(assert, () => psSim.simulate({ seed: -2 }), /option 'seed'/);
+  throwsError(assert, () => psSim.simulate({ step: 0 }), /option 'step'/, /0\.05/);
+  throwsError(assert, () => psSim.simulate({ origin: [1, 2] }), /option 'origin'/, /3 numbers/);
+  throwsError(assert, () => psSim.simulate({ lenght: 3 }), /option 'lenght'/, /layout, seed, step and origin/);
+  const sim = psSim.simulate({ layout: "crossing", seed: 2, step: 5 });
   throwsError(assert, () => sim.scan(sim.length), /out of range/, new RegExp(`${sim.length} scans`));
   throwsError(assert, () => sim.scan(-1), /out of range/);
   throwsError(assert, () => sim.scan(0.5), /out of range/);

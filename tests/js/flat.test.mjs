@@ -3,7 +3,7 @@ import test from "node:test";
 import assert from "node:assert/strict";
 import fs from "node:fs";
 import path from "node:path";
-import { ps, repoRoot } from "./common.mjs";
+import { ps, psSim, repoRoot } from "./common.mjs";
 
 /** The columns hold exactly what polygons() holds, row by row. */
 function assertSame(flat, polygons) {
@@ -27,7 +27,7 @@ function assertSame(flat, polygons) {
 }
 
 test("scenario.polygonsFlat() holds polygons() as typed columns", () => {
-  const sim = ps.simulate({ seed: 1 });
+  const sim = psSim.simulate({ seed: 1 });
   const s = new ps.Scenario();
   for (let k = 0; k < 4; k++) {
     const scan = sim.scan(k);
@@ -51,7 +51,7 @@ test("scenario.polygonsFlat() holds polygons() as typed columns", () => {
 });
 
 test("detectFlat gives detect()'s polygons as columns, and detect()'s errors", () => {
-  const sim = ps.simulate({ seed: 2 });
+  const sim = psSim.simulate({ seed: 2 });
   const scan = sim.scan(0);
   const options = { stride: 4 };
   assertSame(ps.detectFlat(scan.points, options), ps.detect(scan.points, options));

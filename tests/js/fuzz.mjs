@@ -10,7 +10,7 @@
 // call. Every call is timed.
 import { createRequire } from "node:module";
 import path from "node:path";
-import { ps, repoRoot } from "./common.mjs";
+import { ps, psSim, repoRoot } from "./common.mjs";
 
 const fcPath = path.join(repoRoot, "www/node_modules/fast-check");
 let fc;
@@ -231,7 +231,7 @@ function actions(base) {
         restored.free();
       }
     }),
-    on("simulate", 1, options, (ctx, o) => ps.simulate(o).free()),
+    on("simulate", 1, options, (ctx, o) => psSim.simulate(o).free()),
     on("simulation.scan", 2, fc.oneof(primitive, hostileArray), (ctx, i) => ctx.simulation.scan(i)),
     on("getters", 1, none, (ctx) => {
       const s = ctx.scenario;
@@ -257,7 +257,7 @@ export function fuzz({ calls, seed, keep = 5, slowMs = 1000 }) {
     counts[kind]++;
     if (examples.filter((e) => e.kind === kind).length < keep) examples.push({ kind, label, detail: String(detail) });
   };
-  const ctx = { scenario: new ps.Scenario(), simulation: ps.simulate({ layout: "crossing", step: 10 }) };
+  const ctx = { scenario: new ps.Scenario(), simulation: psSim.simulate({ layout: "crossing", step: 10 }) };
   ctx.scenario.addScan(PLANE, { pose: POSE });
   const base = JSON.parse(ctx.scenario.toJSONString());
   const arb = actions(base);

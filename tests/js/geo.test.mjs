@@ -2,7 +2,7 @@
 import test from "node:test";
 import assert from "node:assert/strict";
 import { register } from "node:module";
-import { ps } from "./common.mjs";
+import { ps, psSim } from "./common.mjs";
 
 register("./resolve-www.mjs", import.meta.url);
 const geo = await import("../../js/geo.mjs");
@@ -140,7 +140,7 @@ test("walls are written as 3D polygons that keep their area, with kind propertie
 });
 
 test("every wall of a simulated drive keeps its area through GeoJSON; flat and object input agree", () => {
-  const sim = ps.simulate({ seed: 1 });
+  const sim = psSim.simulate({ seed: 1 });
   const s = new ps.Scenario();
   for (let k = 0; k < 3; k++) {
     const scan = sim.scan(k);
@@ -186,7 +186,7 @@ test("map footprints: outlines for the ground, thin extrudable rectangles for wa
 });
 
 test("glTF: a valid .glb (header, chunks, buffer views and accessors within their lengths)", () => {
-  const sim = ps.simulate({ seed: 1 });
+  const sim = psSim.simulate({ seed: 1 });
   const s = new ps.Scenario();
   const scan = sim.scan(0);
   s.addScan(scan.points, { stride: 4, pose: scan.pose });

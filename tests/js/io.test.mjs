@@ -11,14 +11,14 @@ import { register } from "node:module";
 import { execFileSync } from "node:child_process";
 import fs from "node:fs";
 import path from "node:path";
-import { cli, ps, repoRoot, tempDir } from "./common.mjs";
+import { cli, ps, psSim, repoRoot, tempDir } from "./common.mjs";
 import * as fx from "./io-fixtures.mjs";
 
 register("./resolve-www.mjs", import.meta.url);
 const io = await import("../../js/io.mjs");
 
 /** Scan 0 of the simulated street, on a 1/1024 m grid (exact in every format). */
-const sim = ps.simulate({ layout: "street", seed: 1 });
+const sim = psSim.simulate({ layout: "street", seed: 1 });
 const POINTS = fx.onGrid(sim.scan(0).points, 4);
 sim.free();
 const LOCAL_BIN = fx.rawBin(POINTS);
@@ -114,7 +114,7 @@ test("LAS: the CRS of its GeoTIFF keys or WKT record comes back, ready for polys
 });
 
 test("a KITTI sequence with calib.txt gives the map of its LiDAR poses; without calib it is refused", async () => {
-  const drive = ps.simulate({ layout: "street", seed: 2 });
+  const drive = psSim.simulate({ layout: "street", seed: 2 });
   const n = 6;
   const scans = [];
   for (let k = 0; k < n; k++) scans.push(drive.scan(k));
@@ -277,7 +277,7 @@ test("the LZF decoder of binary_compressed PCD reads back references and literal
 test("polyscene/io/node: a KITTI dataset root on disk gives the CLI's replay map, to 1 mm (the conventions of src/io/kitti.rs); files by path", async () => {
   const node = await import("../../js/io-node.mjs");
   const dir = tempDir("io-kitti");
-  const drive = ps.simulate({ layout: "street", seed: 2 });
+  const drive = psSim.simulate({ layout: "street", seed: 2 });
   const tr = fx.calibTr();
   const root = path.join(dir, "dataset");
   const seq = path.join(root, "sequences", "00");

@@ -4,13 +4,13 @@
 // out is refused with the fix in the message.
 import { test } from "node:test";
 import assert from "node:assert/strict";
-import { ps, throwsError } from "./common.mjs";
+import { ps, psSim, throwsError } from "./common.mjs";
 
 const UTM = [500_000, 4_500_000, 50];
 
 /** Scan 0 of the simulated street: sensor-frame Float32Array (stride 4) and its pose. */
 function scan() {
-  const sim = ps.simulate({ layout: "street", seed: 1 });
+  const sim = psSim.simulate({ layout: "street", seed: 1 });
   const s = sim.scan(0);
   sim.free();
   return s;

@@ -2,10 +2,10 @@
 // polygons.
 import { test } from "node:test";
 import assert from "node:assert/strict";
-import { ps } from "./common.mjs";
+import { ps, psSim } from "./common.mjs";
 
 test("mesh(): indices in range, one polygon id per triangle, areas and orientation match", () => {
-  const sim = ps.simulate({ layout: "crossing", seed: 4 });
+  const sim = psSim.simulate({ layout: "crossing", seed: 4 });
   const scenario = new ps.Scenario({ hull: "concave" });
   for (let k = 0; k < 6; k++) {
     const s = sim.next();

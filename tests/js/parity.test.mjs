@@ -4,7 +4,7 @@ import { test } from "node:test";
 import assert from "node:assert/strict";
 import fs from "node:fs";
 import path from "node:path";
-import { ps, cli, tempDir, readPoses, realScan, dataDir } from "./common.mjs";
+import { ps, psSim, cli, tempDir, readPoses, realScan, dataDir } from "./common.mjs";
 
 const SCANS = 15;
 const dir = tempDir("parity");
@@ -38,7 +38,7 @@ function assertSamePolygons(got, want, what) {
 }
 
 test("simulate() gives the native simulator's scans bit for bit", () => {
-  const sim = ps.simulate({ layout: "street", seed: 3 });
+  const sim = psSim.simulate({ layout: "street", seed: 3 });
   const poses = readPoses(path.join(drive, "poses.txt"));
   assert.equal(poses.length, SCANS);
   for (let k = 0; k < SCANS; k++) {
@@ -56,7 +56,7 @@ test("simulate() gives the native simulator's scans bit for bit", () => {
 });
 
 test("a simulated drive gives the native replay's polygons and reports exactly", () => {
-  const sim = ps.simulate({ layout: "street", seed: 3 });
+  const sim = psSim.simulate({ layout: "street", seed: 3 });
   const scenario = new ps.Scenario(); // the CLI's defaults: gpp2, concave, seed 7
   for (let k = 0; k < SCANS; k++) {
     const { points, pose, stride } = sim.next();

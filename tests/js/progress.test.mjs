@@ -2,10 +2,10 @@
 // JS callback (a `catch` import) and stops when the callback says so.
 import { test } from "node:test";
 import assert from "node:assert/strict";
-import { ps } from "./common.mjs";
+import { ps, psSim } from "./common.mjs";
 
 function scanPoints() {
-  const sim = ps.simulate({ seed: 2 });
+  const sim = psSim.simulate({ seed: 2 });
   const { points } = sim.scan(0);
   sim.free();
   return points;
@@ -50,7 +50,7 @@ test("an exception thrown by onProgress is the cause of the Error thrown, and do
     );
   }
   const s = new ps.Scenario();
-  const sim = ps.simulate({ seed: 2 });
+  const sim = psSim.simulate({ seed: 2 });
   const { pose } = sim.scan(0);
   assert.ok(s.addScan(points, { stride: 4, pose }).polygonCount > 5, "the module still works");
   s.free();

@@ -2,11 +2,11 @@
 // gives exactly what not stopping gives.
 import { test } from "node:test";
 import assert from "node:assert/strict";
-import { ps } from "./common.mjs";
+import { ps, psSim } from "./common.mjs";
 
 const SCANS = 12;
 const STOP = 6;
-const sim = ps.simulate({ layout: "crossing", seed: 5 });
+const sim = psSim.simulate({ layout: "crossing", seed: 5 });
 const scans = Array.from({ length: SCANS }, (_, k) => sim.scan(k));
 sim.free();
 

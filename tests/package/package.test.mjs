@@ -98,15 +98,15 @@ after(async () => {
 
 test('the tarball: one package, licences, types, an exports map, no placeholder URL', () => {
   const files = execFileSync('tar', ['tzf', tarball], { encoding: 'utf8' }).split('\n').filter(Boolean);
-  for (const f of ['LICENSE-MIT', 'LICENSE-APACHE', 'README.md', 'web/polyscene.d.ts', 'web/polyscene_bg.wasm', 'node/polyscene.cjs', 'worker/worker.js', 'geo/index.js', 'geo/index.d.ts', 'io/index.js', 'io/index.d.ts']) {
+  for (const f of ['LICENSE-MIT', 'LICENSE-APACHE', 'README.md', 'web/polyscene.d.ts', 'web/polyscene_bg.wasm', 'node/polyscene.cjs', 'web/polyscene_sim.d.ts', 'web/polyscene_sim_bg.wasm', 'node/polyscene_sim.cjs', 'worker/worker.js', 'geo/index.js', 'geo/index.d.ts', 'io/index.js', 'io/index.d.ts']) {
     assert.ok(files.includes(`package/${f}`), `${f} in the tarball`);
   }
-  assert.equal(files.filter((f) => f.endsWith('.wasm')).length, 1, 'one copy of the wasm');
+  assert.deepEqual(files.filter((f) => f.endsWith('.wasm')).sort(), ['package/web/polyscene_bg.wasm', 'package/web/polyscene_sim_bg.wasm'], 'one copy of each wasm');
   const dir = path.join(app, 'node_modules/polyscene');
   const manifest = JSON.parse(fs.readFileSync(path.join(dir, 'package.json'), 'utf8'));
   assert.equal(manifest.name, 'polyscene');
   assert.equal(manifest.license, 'MIT OR Apache-2.0');
-  assert.ok(manifest.engines?.node && manifest.exports['.'] && manifest.exports['./worker'] && manifest.types);
+  assert.ok(manifest.engines?.node && manifest.exports['.'] && manifest.exports['./worker'] && manifest.exports['./sim'] && manifest.types);
   assert.equal(manifest.sideEffects, false);
   assert.match(fs.readFileSync(path.join(dir, 'LICENSE-APACHE'), 'utf8'), /Apache License\s+Version 2\.0/);
   assert.match(fs.readFileSync(path.join(dir, 'LICENSE-MIT'), 'utf8'), /Permission is hereby granted/);
@@ -156,7 +156,7 @@ test('Node CommonJS: require("polyscene") detects the plane; the README example 
   // The README's example reads scan.bin: one simulated scan, KITTI layout.
   fs.writeFileSync(
     path.join(app, 'make-scan.cjs'),
-    `const { simulate } = require("polyscene");
+    `const { simulate } = require("polyscene/sim");
      const s = simulate({ seed: 1 }).scan(0).points;
      require("node:fs").writeFileSync("scan.bin", Buffer.from(s.buffer, s.byteOffset, s.byteLength));`,
   );
@@ -188,13 +188,15 @@ console.log(JSON.stringify({ polygons: polygons.length, triangles: mesh.indices.
 test('the .d.ts compiles under tsc --strict with the ES2022 libs (bundler and node16 resolution)', () => {
   fs.writeFileSync(
     path.join(app, 'typed.ts'),
-    `import init, { Scenario, detect, simulate, defaultOptions, type Polygon } from "polyscene";
+    `import init, { Scenario, detect, defaultOptions, type Polygon } from "polyscene";
+import initSim, { simulate, type SimulatedScan } from "polyscene/sim";
 import { PolysceneClient } from "polyscene/worker";
 import { readPoints, kittiSequence, type PointCloud } from "polyscene/io";
 await init();
+await initSim();
 const s = new Scenario();
 const sim = simulate();
-const scan = sim.scan(0);
+const scan: SimulatedScan = sim.scan(0);
 const report = s.addScan(scan.points, { stride: 4, pose: scan.pose });
 const n: number = report.polygonCount;
 const found: Polygon[] = detect(new Float32Array(9));
@@ -219,11 +221,11 @@ console.log(detect(cloud.points, { stride: cloud.stride }), epsg);
   run(tsc, ['-p', 'tsconfig.bundler.json']);
   fs.writeFileSync(
     path.join(app, 'typed-node.mts'),
-    `import init, { detect } from "polyscene";\nimport { readPointsFile, openKittiSequence } from "polyscene/io/node";\nawait init();\nconst n: number = detect(new Float32Array(9), { stride: 3 }).length;\nconst c = await readPointsFile("scan.las");\nconst seq = await openKittiSequence("kitti", { sequence: "00", calib: "calib.txt" });\nconsole.log(n, c.crs?.epsg, seq.length);\n`,
+    `import init, { detect } from "polyscene";\nimport { simulate } from "polyscene/sim";\nimport { readPointsFile, openKittiSequence } from "polyscene/io/node";\nawait init();\nconst n: number = detect(new Float32Array(9), { stride: 3 }).length;\nconst pts: Float32Array = simulate({ seed: 2 }).scan(0).points;\nconst c = await readPointsFile("scan.las");\nconst seq = await openKittiSequence("kitti", { sequence: "00", calib: "calib.txt" });\nconsole.log(n, pts.length, c.crs?.epsg, seq.length);\n`,
   );
   fs.writeFileSync(
     path.join(app, 'typed-node.cts'),
-    `import ps = require("polyscene");\nconst s = new ps.Scenario({ preset: "gpp1" });\nconst n: number = s.polygonCount;\ns.free();\nexport = n;\n`,
+    `import ps = require("polyscene");\nimport sim = require("polyscene/sim");\nconst s = new ps.Scenario({ preset: "gpp1" });\nconst n: number = s.polygonCount + sim.simulate().length;\ns.free();\nexport = n;\n`,
   );
   fs.writeFileSync(path.join(app, 'tsconfig.node.json'), config('node16', ['typed-node.mts', 'typed-node.cts']));
   run(tsc, ['-p', 'tsconfig.node.json']);
@@ -234,7 +236,8 @@ const FIXTURES = pathToFileURL(path.join(ROOT, 'tests/js/io-fixtures.mjs')).href
 test('Node ESM: polyscene/io reads LAS at UTM (with its CRS, through @loaders.gl/las installed as a dependency), PCD, PLY and a KITTI sequence with calib; polygons equal the local .bin\'s to 1 mm', () => {
   fs.writeFileSync(
     path.join(app, 'io.mjs'),
-    `import { detect, simulate, Scenario } from "polyscene";
+    `import { detect, Scenario } from "polyscene";
+     import { simulate } from "polyscene/sim";
      import { readPoints, readKittiBin, kittiSequence } from "polyscene/io";
      import * as fx from "${FIXTURES}";
      const sim = simulate({ layout: "street", seed: 1 });
@@ -377,13 +380,18 @@ async function inChromium(dir, { page = 'index.html', waitLog, url } = {}) {
 
 /** The browser test app: direct detect, the README page example, optionally the worker client and the README worker example. */
 function browserApp({ importFrom, initArg = '', worker }) {
+  // The README page example's initSim() finds the simulator loaded when the
+  // app loaded it first: inlined, or from the file esbuild emitted.
+  const inline = importFrom === 'polyscene/inline';
   return `import init, { detect } from "${importFrom}";
-${initArg ? `import wasmUrl from "polyscene/polyscene_bg.wasm";` : ''}
+${initArg ? `import wasmUrl from "polyscene/polyscene_bg.wasm";\nimport simWasmUrl from "polyscene/polyscene_sim_bg.wasm";\nimport initSim from "polyscene/sim";` : ''}
+${inline ? `import initSim from "polyscene/sim/inline";` : ''}
 ${worker ? `import { PolysceneClient } from "polyscene/worker";` : ''}
 import { plane, summary } from "./plane.mjs";
 const out = {};
 try {
   await init(${initArg});
+  ${initArg ? 'await initSim({ module_or_path: simWasmUrl });' : inline ? 'await initSim();' : ''}
   out.direct = summary(detect(plane(), { stride: 3 }));
   const readme = await import("./readme-browser.mjs");
   out.readme = readme.result;
@@ -500,8 +508,9 @@ test('esbuild: polyscene/inline with no config, and polyscene with --loader:.was
   writeBrowserSources(dir);
   const esbuild = path.join(TOOLS, 'esbuild');
   const html = '<!doctype html><meta charset="utf-8"><script type="module" src="./main.js"></script>';
-  // Zero config: the inlined wasm. (The README example's "polyscene" is the
-  // same module instance, so its init() finds the wasm loaded.)
+  // Zero config: the inlined wasm (polyscene/inline, polyscene/sim/inline).
+  // (The README example's "polyscene" and "polyscene/sim" are the same module
+  // instances, so their init() finds the wasm loaded.)
   fs.writeFileSync(path.join(dir, 'main.mjs'), browserApp({ importFrom: 'polyscene/inline', worker: false }));
   let r = run(esbuild, ['main.mjs', '--bundle', '--format=esm', '--splitting', '--outdir=dist-inline'], { cwd: dir });
   assert.doesNotMatch(r.stderr, /warning|Duplicate member/i, `esbuild (inline) warned: ${r.stderr}`);

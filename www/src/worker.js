@@ -60,7 +60,10 @@
 // Back-pressure: at most MAX_IN_FLIGHT scans are posted and not yet acked, so
 // a slow page (software WebGL) never gets a growing queue of scans.
 
-import init, { Scenario, detectWithProgress, simulate, defaultOptions } from '../pkg/polyscene.js';
+import init, { Scenario, detectWithProgress, defaultOptions } from '../pkg/polyscene.js';
+// The simulator is a wasm of its own (polyscene/sim), so that the detection
+// wasm does not carry it; its scans go into the Scenario as copies.
+import initSim, { simulate } from '../pkg/polyscene_sim.js';
 
 const MAX_IN_FLIGHT = 2;
 const PROGRESS_MS = 50;
@@ -81,7 +84,7 @@ const st = {
   fatal: false,
 };
 
-const ready = init()
+const ready = Promise.all([init(), initSim()])
   .then(() => postMessage({ type: 'ready', defaults: { gpp1: defaultOptions('gpp1'), gpp2: defaultOptions('gpp2') } }))
   .catch((e) => {
     st.fatal = true;
