@@ -284,10 +284,30 @@ impl<'p> Detector<'p> {
                         break;
                     }
                     // 4-5. Refit, outline and judge.
-                    let judged = round::judge(support_pts, origin, viewpoint, ground, p, policy);
+                    let mut judged =
+                        round::judge(support_pts, origin, viewpoint, ground, p, policy);
                     if k == 0 {
                         step.area = judged.shaped.as_ref().map_or(0.0, |s| s.primitive.area);
                     }
+                    // Too rough, nothing else wrong, and in two layers: two
+                    // surfaces a step apart. Judge the larger one alone; the
+                    // rest of the cluster stays in play.
+                    let mut layer: Option<Vec<u32>> = None;
+                    if policy.split_rough_layers && judged.only_too_rough {
+                        if let Some((near, again)) = round::judge_dominant_layer(
+                            &judged,
+                            support_pts,
+                            origin,
+                            viewpoint,
+                            ground,
+                            p,
+                            policy,
+                        ) {
+                            layer = Some(near.iter().map(|&i| cluster[i]).collect());
+                            judged = again;
+                        }
+                    }
+                    let cluster: &Vec<u32> = layer.as_ref().unwrap_or(cluster);
                     // 6. Accept and take the support out of play, or take out
                     //    the whole cluster (it would come back the same).
                     match judged.shaped {

@@ -1,5 +1,5 @@
 //! Which of the cascade's rules apply: one-shot detection and the
-//! scenario's detection on each scan's leftovers differ in six of them.
+//! scenario's detection on each scan's leftovers differ in seven of them.
 
 /// The rule set of one detection cascade. The parameters ([`Params`])
 /// say how much (distances, areas, budgets); the policy says which rules
@@ -43,6 +43,13 @@ pub struct CascadePolicy {
     /// or clusters found (with outlines that can merge, see
     /// [`HullKind`](crate::params::HullKind)).
     pub merge_pieces: bool,
+    /// A candidate that fails only the roughness test, and whose points lie
+    /// in two parallel layers with a gap between them, is two surfaces a
+    /// step apart that one plane holds within the inlier distance (a road
+    /// and a plaza 10 cm higher): the layer holding more points is judged
+    /// on its own and the rest stays in play, instead of the whole
+    /// candidate leaving play.
+    pub split_rough_layers: bool,
 }
 
 impl CascadePolicy {
@@ -58,6 +65,7 @@ impl CascadePolicy {
             reject_edge_on_candidates: true,
             ground: GroundBy::Viewpoint,
             merge_pieces: true,
+            split_rough_layers: true,
         }
     }
 
@@ -79,7 +87,9 @@ impl CascadePolicy {
     /// primitives did not explain and on its pool of earlier leftovers:
     /// the largest cluster of each round's plane, fixed clustering
     /// tolerances, twice the hypotheses, no merge pass (the scenario merges
-    /// with its own primitives afterwards). The sampler draws no sliver
+    /// with its own primitives afterwards), no split of rough candidates
+    /// into layers (on the bench's drifting drives it left a duplicate
+    /// pair). The sampler draws no sliver
     /// triples: the pool holds laser rings of many scans, thinned to a
     /// voxel grid, and three points of one ring fix a line, not a plane.
     /// Judging every cluster there measured less precise and less
@@ -95,6 +105,7 @@ impl CascadePolicy {
             reject_edge_on_candidates: true,
             ground: GroundBy::Viewpoint,
             merge_pieces: false,
+            split_rough_layers: false,
         }
     }
 }

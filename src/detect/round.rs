@@ -130,6 +130,8 @@ pub(crate) struct Judged {
     pub(crate) shaped: Option<Shaped>,
     /// Large, solid, smooth, consistent and not seen edge-on.
     pub(crate) accepted: bool,
+    /// Passed every test but roughness.
+    pub(crate) only_too_rough: bool,
 }
 
 /// PCA refit, frame, outline, then the acceptance tests: area, width and
@@ -151,11 +153,105 @@ pub(crate) fn judge(
         ground,
         policy.bridge_ring_gaps,
     );
-    let accepted = shaped.as_ref().is_some_and(|s| {
+    let rest_ok = |s: &Shaped| {
         s.primitive.acceptable(p)
-            && s.roughness <= p.max_roughness
             && !(policy.reject_edge_on_candidates && seen_edge_on(s, viewpoint, p))
             && s.consistency(origin, support_pts, p) >= p.min_normal_consistency
-    });
-    Judged { shaped, accepted }
+    };
+    let smooth = shaped
+        .as_ref()
+        .is_some_and(|s| s.roughness <= p.max_roughness);
+    let rest = shaped.as_ref().is_some_and(rest_ok);
+    Judged {
+        shaped,
+        accepted: smooth && rest,
+        only_too_rough: !smooth && rest,
+    }
+}
+
+/// A candidate that failed only roughness ([`Judged::only_too_rough`]),
+/// judged again as the layer that holds more of its points, when its
+/// points lie in two layers ([`two_layers`]): the points within the inlier
+/// distance of that layer's plane. `Some((positions in support_pts,
+/// judged))` when the layer is accepted; the rest of the candidate stays in
+/// play.
+pub(crate) fn judge_dominant_layer(
+    rough: &Judged,
+    support_pts: &[Vec3],
+    origin: DVec3,
+    viewpoint: DVec3,
+    ground: GroundRule,
+    p: &Params,
+    policy: &CascadePolicy,
+) -> Option<(Vec<usize>, Judged)> {
+    let s = rough.shaped.as_ref()?;
+    let world: Vec<DVec3> = support_pts.iter().map(|q| origin + q.as_dvec3()).collect();
+    let distance = p.surface(s.primitive.ground).distance;
+    // The layers are found on every k-th point (at most about 50,000): a
+    // plane needs no more, and a road's candidate can hold a million.
+    let every = world.len().div_ceil(50_000).max(1);
+    let sample: Vec<DVec3> = world.iter().copied().step_by(every).collect();
+    let layer = two_layers(&s.primitive.plane, &sample, distance)?;
+    let near: Vec<usize> = (0..world.len())
+        .filter(|&i| layer.signed_distance(world[i]).abs() <= distance)
+        .collect();
+    if near.len() < p.min_inliers || near.len() == world.len() {
+        return None;
+    }
+    let pts: Vec<Vec3> = near.iter().map(|&i| support_pts[i]).collect();
+    let again = judge(&pts, origin, viewpoint, ground, p, policy);
+    again.accepted.then_some((near, again))
+}
+
+/// The plane of the layer holding more of `world`, when the points lie in
+/// two parallel layers with a gap between them; `None` for points that
+/// fill the band (a plane through clutter). From `plane` (between the
+/// layers), fit the side holding more points, then refit on the points
+/// within half the inlier `distance` until the plane settles on its layer.
+/// The other side's points, seen from that layer, must sit mostly at one
+/// offset: fewer than a tenth of them in the middle third between the
+/// layer and their median offset, which is at least half the inlier
+/// distance away.
+fn two_layers(plane: &Plane, world: &[DVec3], distance: f64) -> Option<Plane> {
+    use crate::geometry::plane::robust_fit;
+    let fit = |pts: &[DVec3]| robust_fit(pts, pts.first()?.round()).map(|f| f.plane);
+    let above = world
+        .iter()
+        .filter(|&&w| plane.signed_distance(w) >= 0.0)
+        .count();
+    let upper = 2 * above >= world.len();
+    let side: Vec<DVec3> = world
+        .iter()
+        .copied()
+        .filter(|&w| (plane.signed_distance(w) >= 0.0) == upper)
+        .collect();
+    let mut layer = fit(&side)?;
+    for _ in 0..4 {
+        let near: Vec<DVec3> = world
+            .iter()
+            .copied()
+            .filter(|&w| layer.signed_distance(w).abs() <= 0.5 * distance)
+            .collect();
+        layer = fit(&near)?;
+    }
+    // The other layer: the points beyond the inlier distance, on one side.
+    let mut h: Vec<f64> = world
+        .iter()
+        .map(|&w| layer.signed_distance(w))
+        .filter(|d| d.abs() > distance)
+        .collect();
+    if h.is_empty() {
+        return None;
+    }
+    let positive = h.iter().filter(|&&d| d > 0.0).count();
+    let sign = if 2 * positive >= h.len() { 1.0 } else { -1.0 };
+    h.retain(|&d| d * sign > 0.0);
+    let mid = h.len() / 2;
+    let step = h.select_nth_unstable_by(mid, |a, b| a.total_cmp(b)).1.abs();
+    let middle = world
+        .iter()
+        .map(|&w| layer.signed_distance(w) * sign)
+        .filter(|&d| d > step / 3.0 && d < 2.0 * step / 3.0)
+        .count();
+    (step >= 0.5 * distance && 10 * middle < h.len()).then_some(layer)
 }
