@@ -135,9 +135,8 @@ pub fn triangulate_ring(ring: &[DVec2]) -> Option<RingTriangles> {
         return None;
     }
     // Built one vertex and one edge at a time, in ring order: spade's bulk
-    // loader re-inserts what it skipped from a hash set with a random
-    // hasher, so the same ring could come out as other triangles (or the
-    // same ones in another order) from one call to the next.
+    // loader re-inserts what it skipped in the order of a hash set with a
+    // randomly seeded hasher, and nothing in the mesh may depend on that.
     let mut cdt: ConstrainedDelaunayTriangulation<Point2<f64>> =
         ConstrainedDelaunayTriangulation::new();
     let mut handles = Vec::with_capacity(n);
@@ -315,8 +314,8 @@ mod tests {
     }
 
     /// The same ring gives the same triangles, in the same order, every
-    /// time (spade's bulk loader did not: it re-inserts the vertices it
-    /// skipped in the order of a randomly seeded hash set).
+    /// time (spade's bulk loader left part of its order to a randomly
+    /// seeded hash set).
     #[test]
     fn the_same_ring_gives_the_same_triangles_every_time() {
         let mut rng = crate::rng::Rng::new(5);

@@ -208,10 +208,9 @@ pub(crate) fn judge_dominant_layer(
 /// fill the band (a plane through clutter). From `plane` (between the
 /// layers), fit the side holding more points, then refit on the points
 /// within half the inlier `distance` until the plane settles on its layer.
-/// The other side's points, seen from that layer, must sit mostly at one
-/// offset: fewer than a tenth of them in the middle third between the
-/// layer and their median offset, which is at least half the inlier
-/// distance away.
+/// The other side's points beyond the inlier distance, seen from that
+/// layer, must sit mostly at one offset: fewer than a tenth of their
+/// number in the middle third between the layer and their median offset.
 fn two_layers(plane: &Plane, world: &[DVec3], distance: f64) -> Option<Plane> {
     use crate::geometry::plane::robust_fit;
     let fit = |pts: &[DVec3]| robust_fit(pts, pts.first()?.round()).map(|f| f.plane);
@@ -253,5 +252,5 @@ fn two_layers(plane: &Plane, world: &[DVec3], distance: f64) -> Option<Plane> {
         .map(|&w| layer.signed_distance(w) * sign)
         .filter(|&d| d > step / 3.0 && d < 2.0 * step / 3.0)
         .count();
-    (step >= 0.5 * distance && 10 * middle < h.len()).then_some(layer)
+    (10 * middle < h.len()).then_some(layer)
 }
