@@ -10,7 +10,7 @@
 // call. Every call is timed.
 import { createRequire } from "node:module";
 import path from "node:path";
-import { ps, psSim, repoRoot } from "./common.mjs";
+import { floor, ps, psSim, repoRoot } from "./common.mjs";
 
 const fcPath = path.join(repoRoot, "www/node_modules/fast-check");
 let fc;
@@ -23,21 +23,7 @@ try {
 const ID = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1];
 const POSE = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -1.4, -1.4, -1.8, 1];
 
-/** A flat grid: `n` x `n` points `step` apart at height `z` (stride 3). */
-function grid(n, step, z = 0) {
-  const pts = new Float32Array(n * n * 3);
-  let k = 0;
-  for (let i = 0; i < n; i++) {
-    for (let j = 0; j < n; j++) {
-      pts[k++] = i * step;
-      pts[k++] = j * step;
-      pts[k++] = z;
-    }
-  }
-  return pts;
-}
-
-const PLANE = grid(15, 0.2); // 2.8 m x 2.8 m, 225 points
+const PLANE = floor(15, 0.2); // 2.8 m x 2.8 m, 225 points
 // Few hypotheses: the check runs after every throw, and a plane needs few.
 const HEALTH = { viewpoint: [1.4, 1.4, 1.8], maxHypotheses: 10 };
 

@@ -12,6 +12,21 @@ import { PLYLoader } from 'three/addons/loaders/PLYLoader.js';
 
 export class FileError extends Error {}
 
+/**
+ * The text of a snapshot file (a .json from "scenario snapshot"), checked to
+ * be one: a FileError naming the file otherwise. Both pages load snapshots.
+ */
+export async function readSnapshotText(file) {
+  try {
+    const text = await file.text();
+    const o = JSON.parse(text);
+    if (!o || typeof o !== 'object' || !('params' in o)) throw new Error('it is JSON, but not a polyscene snapshot (no "params")');
+    return text;
+  } catch (e) {
+    throw new FileError(`${file.name}: cannot load the snapshot: ${e.message || e}`);
+  }
+}
+
 const SCAN_EXT = ['.bin', '.pcd', '.ply'];
 
 function ext(name) {

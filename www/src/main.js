@@ -7,7 +7,7 @@ import GUI from 'lil-gui';
 import { PolysceneClient } from './client.js';
 import { SceneView } from './view.js';
 import { Sparkline } from './charts.js';
-import { readScanFiles, parseKittiBin, FileError } from './files.js';
+import { readScanFiles, parseKittiBin, readSnapshotText, FileError } from './files.js';
 import { toJSON, toGeoJSON, toGLB, toOBJ, download } from './export.js';
 import { idCss } from './palette.js';
 
@@ -411,11 +411,9 @@ class App {
   async loadSnapshot(file) {
     let text;
     try {
-      text = await file.text();
-      const o = JSON.parse(text);
-      if (!o || typeof o !== 'object' || !('params' in o)) throw new Error('it is JSON, but not a polyscene snapshot (no "params")');
+      text = await readSnapshotText(file);
     } catch (e) {
-      this.toast(`${file.name}: cannot load the snapshot: ${e.message || e}`);
+      this.toast(e.message);
       return;
     }
     this.pause();

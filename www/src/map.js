@@ -19,7 +19,7 @@
 import * as maplibregl from 'maplibre-gl';
 import { geoFrame, mapFeatures } from 'polyscene/geo';
 import { PolysceneClient } from './client.js';
-import { readScanFiles, FileError } from './files.js';
+import { readScanFiles, readSnapshotText, FileError } from './files.js';
 import { kittiSequence, readPoints, sniffFormat } from 'polyscene/io';
 
 const $ = (id) => document.getElementById(id);
@@ -302,11 +302,9 @@ async function openScans(files) {
 async function openSnapshot(file) {
   let text;
   try {
-    text = await file.text();
-    const o = JSON.parse(text);
-    if (!o || typeof o !== 'object' || !('params' in o)) throw new Error('it is JSON, but not a polyscene snapshot (no "params")');
+    text = await readSnapshotText(file);
   } catch (e) {
-    toast(`${file.name}: cannot load the snapshot: ${e.message || e}`);
+    toast(e.message);
     return;
   }
   client.restore(text, file.name);
