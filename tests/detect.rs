@@ -1194,3 +1194,63 @@ fn roads_and_plazas_a_step_above_them_are_separate_surfaces() {
         );
     }
 }
+
+#[test]
+fn a_sparse_wall_behind_dense_clutter_is_found() {
+    let mut rng = Rng::new(11);
+    let mut pts = Vec::new();
+    // Ground, 40 x 20 m, and a wall 12 x 3 m at y = 15 seen sparsely
+    // (0.25 m apart: 16 points a square metre, 637 in all).
+    rect(
+        &mut pts,
+        DVec3::new(-20.0, 0.0, 0.0),
+        DVec3::X,
+        DVec3::Y,
+        40.0,
+        20.0,
+        0.1,
+        0.01,
+        &mut rng,
+    );
+    rect(
+        &mut pts,
+        DVec3::new(-6.0, 15.0, 0.0),
+        DVec3::X,
+        DVec3::Z,
+        12.0,
+        3.0,
+        0.25,
+        0.01,
+        &mut rng,
+    );
+    // Bins and posts, seen close: cylinders of 0.3 m radius, 1.2 m high,
+    // 3000 points each. A plane along one holds more points than the wall
+    // and makes a candidate that is too small.
+    for _ in 0..25 {
+        let c = DVec3::new(rng.range(-18.0, 18.0), rng.range(2.0, 12.0), 0.0);
+        for _ in 0..3000 {
+            let a = rng.range(0.0, std::f64::consts::TAU);
+            let r = 0.3 + 0.01 * rng.gaussian();
+            pts.push(c + DVec3::new(r * libm::cos(a), r * libm::sin(a), rng.range(0.0, 1.2)));
+        }
+    }
+    let c = cloud(&pts);
+    let p = Params {
+        viewpoint: Some([0.0, 0.0, 1.8]),
+        ..Params::gpp2()
+    };
+    let det = detect(&c, &p).unwrap();
+    check_invariants(&c, &det, &p);
+    let found: f64 = det
+        .primitives
+        .iter()
+        .filter(|q| q.plane.normal.y.abs() > 0.999 && (q.plane.offset.abs() - 15.0).abs() < 0.05)
+        .map(|q| q.area)
+        .sum();
+    let got: Vec<_> = det
+        .primitives
+        .iter()
+        .map(|q| (q.plane.normal, q.area))
+        .collect();
+    assert!(found > 0.8 * 36.0, "wall: {found:.1} m^2 of 36: {got:?}");
+}

@@ -26,6 +26,23 @@ use ransac::PlanePool;
 use serde::Serialize;
 use std::ops::ControlFlow;
 
+/// When a stalled cascade clears clutter
+/// ([`CascadePolicy::clear_scattered_on_stall`]): a sampling voxel holds no
+/// plane when its live points spread across their best-fitting plane
+/// (RMS) by more than this many times the median RMS of the supports
+/// accepted so far: the noise of this cloud's own surfaces, so a noisier
+/// sensor keeps more. Clutter (crowns, trunks, poles, bins, people) spreads
+/// by tens of centimetres.
+const SCATTERED_SPREAD: f64 = 1.5;
+/// The spread allowed before any support was accepted, as a share of the
+/// inlier distance (which is set at about three times the surfaces' noise).
+const SCATTERED_SPREAD_UNKNOWN: f64 = 1.0 / 3.0;
+/// The least spread allowed, as a share of the inlier distance: noise-free
+/// synthetic surfaces would otherwise set it to rounding error.
+const SCATTERED_SPREAD_FLOOR: f64 = 0.05;
+/// Fewest live points in a voxel for its spread to be judged.
+const SCATTERED_MIN_POINTS: usize = 8;
+
 /// One round of the cascade (for the paper's Fig. 9 analysis).
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 #[serde(rename_all = "camelCase")]
@@ -139,6 +156,17 @@ pub fn detect_with_progress(
     Ok(Some(det))
 }
 
+/// The largest spread (m) of a voxel's points across their best plane that
+/// still counts as a surface when a stalled cascade clears clutter.
+fn scattered_spread(accepted_rms: &mut [f64], p: &Params) -> f64 {
+    if accepted_rms.is_empty() {
+        return SCATTERED_SPREAD_UNKNOWN * p.other.distance;
+    }
+    accepted_rms.sort_by(f64::total_cmp);
+    let median = accepted_rms[accepted_rms.len() / 2];
+    (SCATTERED_SPREAD * median).max(SCATTERED_SPREAD_FLOOR * p.other.distance)
+}
+
 /// [`detect_with_progress`] on every point (parameters validated): `None`
 /// when `progress` stopped it.
 fn detect_all(
@@ -248,7 +276,20 @@ impl<'p> Detector<'p> {
         };
         let mut clusterer = cluster::Clusterer::default();
         let mut rejections = 0;
+        // Cleared of scattered voxels yet (see `clear_scattered_on_stall`)?
+        let mut cleared = !policy.clear_scattered_on_stall;
+        // RMS distance (m) of each accepted support from its plane.
+        let mut accepted_rms: Vec<f64> = Vec::new();
         for _ in 0..4 * p.max_primitives + 64 {
+            if !cleared && rejections >= p.max_rejections {
+                // Stalled: the rounds keep finding planes through clutter.
+                // Take out what holds no plane and go on, once.
+                cleared = true;
+                let spread = scattered_spread(&mut accepted_rms, p);
+                if pool.remove_scattered(SCATTERED_MIN_POINTS, spread) > 0 {
+                    rejections = 0;
+                }
+            }
             if out.primitives.len() >= p.max_primitives
                 || pool.work >= p.max_work
                 || rejections >= p.max_rejections
@@ -322,6 +363,7 @@ impl<'p> Detector<'p> {
                                 out.labels[pool.original(v) as usize] = id;
                             }
                             pool.remove(&taken);
+                            accepted_rms.push(s.roughness * p.surface(s.primitive.ground).distance);
                             out.primitives.push(Primitive { id, ..s.primitive });
                             step.accepted += 1;
                         }

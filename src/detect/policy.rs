@@ -1,5 +1,5 @@
 //! Which of the cascade's rules apply: one-shot detection and the
-//! scenario's detection on each scan's leftovers differ in seven of them.
+//! scenario's detection on each scan's leftovers differ in eight of them.
 
 /// The rule set of one detection cascade. The parameters ([`Params`])
 /// say how much (distances, areas, budgets); the policy says which rules
@@ -50,6 +50,16 @@ pub struct CascadePolicy {
     /// on its own and the rest stays in play, instead of the whole
     /// candidate leaving play.
     pub split_rough_layers: bool,
+    /// When `maxRejections` rounds in a row accepted nothing, the points of
+    /// every sampling voxel that holds no plane (their spread across the
+    /// best-fitting one over 1.5 times the median spread of the supports
+    /// accepted so far) leave play,
+    /// once, and the cascade goes on. Such a stall comes from planes through
+    /// clutter (rows of trunks, poles, bins) that score more than a sparse
+    /// far facade or car side and make candidates that fail; the surfaces
+    /// behind them then never get a round. Only after a stall: before it,
+    /// voxels where two surfaces meet are not planar either.
+    pub clear_scattered_on_stall: bool,
 }
 
 impl CascadePolicy {
@@ -66,6 +76,7 @@ impl CascadePolicy {
             ground: GroundBy::Viewpoint,
             merge_pieces: true,
             split_rough_layers: true,
+            clear_scattered_on_stall: true,
         }
     }
 
@@ -106,6 +117,7 @@ impl CascadePolicy {
             ground: GroundBy::Viewpoint,
             merge_pieces: false,
             split_rough_layers: false,
+            clear_scattered_on_stall: false,
         }
     }
 }

@@ -387,6 +387,58 @@ impl PlanePool {
         self.rz.truncate(w);
     }
 
+    /// Take out of play the live points of every voxel that holds at least
+    /// `min_points` of them and no plane: their spread across the best
+    /// fitting plane (the square root of the smallest eigenvalue of their
+    /// covariance) exceeds `max_spread`. Returns how many left play.
+    pub fn remove_scattered(&mut self, min_points: usize, max_spread: f64) -> usize {
+        let before = self.live;
+        let max_var = max_spread * max_spread;
+        let mut out: Vec<u32> = Vec::new();
+        for c in 0..self.cell_box.len() {
+            if (self.cell_live[c] as usize) < min_points.max(4) {
+                continue;
+            }
+            let centre = self.cell_box[c].0;
+            let (mut s, mut ss) = (DVec3::ZERO, [[0.0f64; 3]; 3]);
+            let mut n = 0.0;
+            for pos in self.voxels.range(c) {
+                if !self.alive[pos] {
+                    continue;
+                }
+                let d = self.cell_pts[pos].as_dvec3() - centre;
+                s += d;
+                n += 1.0;
+                let a = d.to_array();
+                for (i, row) in ss.iter_mut().enumerate() {
+                    for (j, v) in row.iter_mut().enumerate() {
+                        *v += a[i] * a[j];
+                    }
+                }
+            }
+            let m = s / n;
+            let ma = m.to_array();
+            let mut cov = [[0.0f64; 3]; 3];
+            for (i, row) in cov.iter_mut().enumerate() {
+                for (j, v) in row.iter_mut().enumerate() {
+                    *v = ss[i][j] / n - ma[i] * ma[j];
+                }
+            }
+            let flat =
+                crate::geometry::plane::smallest_eigen3(cov).is_none_or(|(l, _)| l[0] <= max_var);
+            if !flat {
+                out.extend(
+                    self.voxels
+                        .range(c)
+                        .filter(|&pos| self.alive[pos])
+                        .map(|pos| pos as u32),
+                );
+            }
+        }
+        self.remove(&out);
+        before - self.live
+    }
+
     /// The plane with the largest consensus among the remaining points, its
     /// inliers (positions, in voxel order) and their coordinates, or `None`
     /// when no plane has `min_inliers`.

@@ -107,7 +107,9 @@ options! {
     /// Most primitives one detection returns. gpp2 default 200, gpp1 60.
     max_primitives: usize = max_primitives, "", Check::Count(1, 100_000);
     /// The cascade stops after this many rounds in a row accepted nothing
-    /// (what is left is clutter). Default 10.
+    /// (what is left is clutter). One-shot detection first takes the
+    /// points of voxels that hold no plane out of play and goes on, once.
+    /// Default 10.
     max_rejections: usize = max_rejections, "", Check::Count(1, 1_000_000);
     /// Work budget of one detection, in point-to-plane distance evaluations
     /// (about a nanosecond each natively). Default 2e9.
