@@ -1254,3 +1254,65 @@ fn a_sparse_wall_behind_dense_clutter_is_found() {
         .collect();
     assert!(found > 0.8 * 36.0, "wall: {found:.1} m^2 of 36: {got:?}");
 }
+
+/// A tile seen from nowhere: a road at z = 0, a ramp rising at 8 degrees
+/// from it, and a plateau at the ramp's top, 1.41 m above the road. Each
+/// is its own surface, at its own height and slope, over its own area.
+#[test]
+fn a_ramp_and_the_plateau_it_climbs_to_are_found_without_a_viewpoint() {
+    let mut rng = Rng::new(12);
+    let slope = 8f64.to_radians();
+    let (run, top) = (10.0, 10.0 * libm::tan(slope));
+    let mut pts = Vec::new();
+    let mut x = -20.0;
+    while x <= 30.0 {
+        let mut y = 0.0;
+        while y <= 12.0 {
+            let z = if x < 0.0 {
+                0.0
+            } else if x < run {
+                x * libm::tan(slope)
+            } else {
+                top
+            };
+            pts.push(DVec3::new(x, y, z + 0.005 * rng.gaussian()));
+            y += 0.1;
+        }
+        x += 0.1;
+    }
+    let c = cloud(&pts);
+    let p = Params::gpp2();
+    let det = detect(&c, &p).unwrap();
+    check_invariants(&c, &det, &p);
+    let got: Vec<_> = det
+        .primitives
+        .iter()
+        .map(|q| (q.plane.normal, q.plane.offset, q.area))
+        .collect();
+    let ramp_normal = DVec3::new(-libm::sin(slope), 0.0, libm::cos(slope));
+    // Road 20 x 12, ramp 10 / cos(8 deg) x 12, plateau 20 x 12 m^2.
+    for (name, normal, at, want) in [
+        ("road", DVec3::Z, DVec3::new(-10.0, 6.0, 0.0), 240.0),
+        (
+            "ramp",
+            ramp_normal,
+            DVec3::new(5.0, 6.0, 5.0 * libm::tan(slope)),
+            121.2,
+        ),
+        ("plateau", DVec3::Z, DVec3::new(20.0, 6.0, top), 240.0),
+    ] {
+        let area: f64 = det
+            .primitives
+            .iter()
+            .filter(|q| {
+                q.plane.normal.dot(normal) > libm::cos(1f64.to_radians())
+                    && q.plane.signed_distance(at).abs() < 0.03
+            })
+            .map(|q| q.area)
+            .sum();
+        assert!(
+            area > 0.85 * want && area < 1.1 * want,
+            "{name}: {area:.1} m^2 of {want}: {got:?}"
+        );
+    }
+}
