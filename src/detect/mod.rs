@@ -280,6 +280,8 @@ impl<'p> Detector<'p> {
         let mut cleared = !policy.clear_scattered_on_stall;
         // RMS distance (m) of each accepted support from its plane.
         let mut accepted_rms: Vec<f64> = Vec::new();
+        // Pool positions of rejected clusters that stayed in play (step 6).
+        let mut reprieved = vec![false; pts.len()];
         for _ in 0..4 * p.max_primitives + 64 {
             if !cleared && rejections >= p.max_rejections {
                 // Stalled: the rounds keep finding planes through clutter.
@@ -350,7 +352,8 @@ impl<'p> Detector<'p> {
                     }
                     let cluster: &Vec<u32> = layer.as_ref().unwrap_or(cluster);
                     // 6. Accept and take the support out of play, or take out
-                    //    the whole cluster (it would come back the same).
+                    //    the whole largest cluster (with the plane fitted to
+                    //    it, it would come back the same).
                     match judged.shaped {
                         Some(s) if judged.accepted => {
                             let id = out.primitives.len() as u32;
@@ -366,6 +369,16 @@ impl<'p> Detector<'p> {
                             accepted_rms.push(s.roughness * p.surface(s.primitive.ground).distance);
                             out.primitives.push(Primitive { id, ..s.primitive });
                             step.accepted += 1;
+                        }
+                        // The plane was fitted to the largest cluster; another
+                        // was judged on the band of it that the plane's slab
+                        // held (a car's side beside the next one's in a row,
+                        // a plateau beside a road). It stays in play, once,
+                        // to come back whole with its own plane.
+                        _ if k > 0 && !cluster.iter().any(|&v| reprieved[v as usize]) => {
+                            for &v in cluster.iter() {
+                                reprieved[v as usize] = true;
+                            }
                         }
                         _ => pool.remove(cluster),
                     }

@@ -32,7 +32,11 @@ pub struct CascadePolicy {
     pub bridge_ring_gaps: bool,
     /// Every cluster of a round's plane with `minInliers` points is judged,
     /// not only the largest: one plane often holds several surfaces (the
-    /// sides of cars parked in a row, the facades along a street).
+    /// sides of cars parked in a row, the facades along a street). Such a
+    /// cluster, when rejected, stays in play once (none of its points was
+    /// kept so before): it was judged on the band of its surface that a
+    /// plane fitted to another one held, and can come back whole with its
+    /// own plane.
     pub every_cluster: bool,
     /// Candidates whose plane passes through the viewpoint, away from it,
     /// are rejected as laser rings (see `seen_edge_on`).
