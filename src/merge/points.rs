@@ -20,7 +20,8 @@ use glam::{DVec2, DVec3, Vec3};
 /// between them; the caller decides).
 ///
 /// In the order found, a primitive and the newer pieces mergeable with it
-/// become one ([`absorb`]). A merged outline is larger and can touch a
+/// become one ([`absorb`]); a piece that would lose too much of its support
+/// stays apart, and the others merge without it. A merged outline is larger and can touch a
 /// piece it did not touch before, so passes repeat until nothing merges;
 /// after the first, only groups with a primitive grown in the last pass
 /// are looked at.
@@ -63,12 +64,21 @@ pub(crate) fn merge_pieces(
                 }
             });
             group.retain(|&j| j != big);
-            if let Some(out) = absorb(primitives, labels, big, &group, pts, origin, p) {
-                primitives[big] = out;
-                for &j in &group {
-                    into[j] = big as u32;
+            // A piece that would lose too much support stays apart; the
+            // others still merge.
+            while !group.is_empty() {
+                match absorb(primitives, labels, big, &group, pts, origin, p) {
+                    Ok(out) => {
+                        primitives[big] = out;
+                        for &j in &group {
+                            into[j] = big as u32;
+                        }
+                        next[big] = true;
+                        break;
+                    }
+                    Err(failed) if !failed.is_empty() => group.retain(|j| !failed.contains(j)),
+                    Err(_) => break,
                 }
-                next[big] = true;
             }
         }
         if !next.contains(&true) {
@@ -103,9 +113,10 @@ pub(crate) fn merge_pieces(
     }
 }
 
-/// `primitives[big]` with the pieces `group` absorbed, or `None` when the
-/// merge would break the detection contract (support near its plane,
-/// inside its outline). The largest keeps its plane and frame; the pieces'
+/// `primitives[big]` with the pieces `group` absorbed, or the pieces that
+/// would lose too much support when the merge would break the detection
+/// contract (support near its plane, inside its outline; none named when
+/// the outline fails or `big` itself would lose too much). The largest keeps its plane and frame; the pieces'
 /// points on that plane mark its footprint, and one outline trace follows.
 /// Each piece must keep nine tenths of its support within the inlier
 /// distance of the plane and inside the new raster region, and so must the
@@ -119,7 +130,7 @@ fn absorb(
     pts: &[Vec3],
     origin: DVec3,
     p: &Params,
-) -> Option<Primitive> {
+) -> Result<Primitive, Vec<usize>> {
     let n = primitives.len();
     let world = |i: usize| origin + pts[i].as_dvec3();
     let mut out = primitives[big].clone();
@@ -145,15 +156,21 @@ fn absorb(
     out.footprint.mark_all(&marks);
     let (ring, region) = out
         .footprint
-        .outline_region(out.alpha(p), p.simplify, p.max_vertices)?;
+        .outline_region(out.alpha(p), p.simplify, p.max_vertices)
+        .ok_or_else(Vec::new)?;
     let mut kept = Vec::with_capacity(taken.len());
     for &(i, q) in &taken {
         let stay = q.is_some_and(|q| region.contains(q));
         bad[labels[i] as usize] += (q.is_some() && !stay) as usize;
         kept.push(stay);
     }
-    if group.iter().any(|&j| 10 * bad[j] > total[j]) {
-        return None;
+    let failed: Vec<usize> = group
+        .iter()
+        .copied()
+        .filter(|&j| 10 * bad[j] > total[j])
+        .collect();
+    if !failed.is_empty() {
+        return Err(failed);
     }
     // `out` is `big` with the pieces' cells added (same frame): when the
     // region holds all of `big`'s cells it holds all of its points.
@@ -174,7 +191,7 @@ fn absorb(
             }
         }
         if 10 * own_out.len() > own {
-            return None;
+            return Err(Vec::new());
         }
     }
     out.area = signed_area(&ring);
@@ -199,7 +216,7 @@ fn absorb(
         out.moments.merge(&primitives[j].moments);
     }
     out.moments.remove(&gone);
-    Some(out)
+    Ok(out)
 }
 
 #[cfg(test)]
@@ -303,6 +320,34 @@ mod tests {
         assert_eq!(prims.len(), 2);
         assert_eq!(labels, before.1);
         assert_eq!(prims[1].area, before.0[1].area);
+    }
+
+    /// A piece that would lose its support to the larger plane (4 degrees
+    /// off it: mergeable, but its upper part lies beyond the inlier
+    /// distance) does not keep the others from merging with it.
+    #[test]
+    fn a_piece_that_stays_apart_does_not_block_the_others() {
+        let p = Params::gpp2();
+        let a = patch(0.0, 5.0, 0.0, 0.0);
+        let tilted = patch(4.0, 7.0, 0.07, 0.025);
+        let c = patch(-3.0, 1.0, 0.0, 0.025);
+        let (mut prims, mut labels, pts) = pieces(&[&a, &tilted, &c], &p);
+        assert!(mergeable(&prims[0], &prims[1], &p));
+        assert!(mergeable(&prims[0], &prims[2], &p));
+        let tilted_area = prims[1].area;
+        merge_pieces(&mut prims, &mut labels, &pts, DVec3::ZERO, &p);
+        assert_eq!(prims.len(), 2);
+        // 8 m x 2 m, outlined through the boundary cells' centres.
+        assert!(
+            prims[0].area > 14.0 && prims[0].area < 16.1,
+            "area {}",
+            prims[0].area
+        );
+        assert_eq!(prims[1].area, tilted_area);
+        let (na, nt) = (a.len(), tilted.len());
+        assert!(labels[..na].iter().all(|&l| l == 0));
+        assert!(labels[na..na + nt].iter().all(|&l| l == 1));
+        assert!(labels[na + nt..].iter().all(|&l| l == 0));
     }
 
     #[test]
