@@ -147,13 +147,16 @@ fn staircase_gives_each_tread_and_riser() {
     p.ground.distance = 0.05;
     let det = detect(&cloud, &p).unwrap();
     check_invariants(&cloud, &det, &p);
+    // Treads by their orientation: ground is each 4 m column's floor and
+    // what lies within 0.5 m of it, so the upper treads are not ground.
+    let flat = |q: &&polyscene::primitive::Primitive| q.plane.normal.z.abs() > 0.99;
     let treads: Vec<f64> = det
         .primitives
         .iter()
-        .filter(|q| q.ground)
-        .map(|q| -q.plane.offset)
+        .filter(flat)
+        .map(|q| -q.plane.offset * q.plane.normal.z.signum())
         .collect();
-    let risers = det.primitives.iter().filter(|q| !q.ground).count();
+    let risers = det.primitives.len() - treads.len();
     assert_eq!(treads.len(), 5, "treads at {treads:?}");
     assert_eq!(risers, 5);
     for k in 0..5 {

@@ -1,5 +1,5 @@
 //! Which of the cascade's rules apply: one-shot detection and the
-//! scenario's detection on each scan's leftovers differ in eight of them.
+//! scenario's detection on each scan's leftovers differ in nine of them.
 
 /// The rule set of one detection cascade. The parameters ([`Params`])
 /// say how much (distances, areas, budgets); the policy says which rules
@@ -67,7 +67,10 @@ pub struct CascadePolicy {
 }
 
 impl CascadePolicy {
-    /// One-shot detection of a whole cloud: every rule.
+    /// One-shot detection of a whole cloud: every rule, and ground decided
+    /// from the cloud's local floor, with or without a viewpoint (a cloud
+    /// accumulated over a drive has no one sensor height, and a plateau
+    /// or ramp is ground at its own height).
     pub const fn one_shot() -> Self {
         CascadePolicy {
             skip_edge_on_hypotheses: true,
@@ -77,7 +80,7 @@ impl CascadePolicy {
             bridge_ring_gaps: true,
             every_cluster: true,
             reject_edge_on_candidates: true,
-            ground: GroundBy::Viewpoint,
+            ground: GroundBy::LocalFloor,
             merge_pieces: true,
             split_rough_layers: true,
             clear_scattered_on_stall: true,
@@ -85,8 +88,7 @@ impl CascadePolicy {
     }
 
     /// The same rules for a cloud seen from no known position (a map, a
-    /// tile): none of the rules that need the viewpoint, and ground decided
-    /// from the cloud's local floor.
+    /// tile): none of the rules that need the viewpoint.
     pub const fn without_viewpoint(self) -> Self {
         CascadePolicy {
             skip_edge_on_hypotheses: false,

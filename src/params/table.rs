@@ -15,17 +15,20 @@ options! {
     /// Largest tilt from horizontal for a plane to count as ground (deg).
     /// Default 15.
     ground_max_tilt: f64 = ground_max_tilt, "deg", Check::Between(0.0, 90.0);
-    /// Ground lies at least this far below the viewpoint (m); a horizontal
-    /// plane higher up (a car's roof, a table) is an ordinary primitive.
-    /// Default 1.3 (sensors on a car roof sit 1.7-2 m up).
+    /// In the scenario, ground lies at least this far below the scan's
+    /// sensor (m); a horizontal plane higher up (a car's roof, a table) is
+    /// an ordinary primitive. One-shot detection decides ground from the
+    /// cloud's local floor instead. Default 1.3 (sensors on a car roof sit
+    /// 1.7-2 m up).
     ground_depth: f64 = ground_depth, "m", Check::NonNegative;
     /// Sensor position for one-shot detection (world, m): normals of
-    /// non-horizontal planes point towards it, it decides what is ground,
-    /// and a plane through it (seen edge-on: laser rings) is dropped unless
-    /// it reaches within 1 m of it. Default null: the origin when a sensor
-    /// could have stood there (a scan in its own frame), else none (a map:
-    /// ground from the cloud's local floor, no edge-on rules). The scenario
-    /// uses each scan's pose instead.
+    /// non-horizontal planes point towards it, the ground's clustering
+    /// tolerance grows with range from it, and a plane through it (seen
+    /// edge-on: laser rings) is dropped unless it reaches within 1 m of it.
+    /// Ground is decided from the cloud's local floor either way. Default
+    /// null: the origin when a sensor could have stood there (a scan in its
+    /// own frame), else none (a map: no rules that need a viewpoint). The
+    /// scenario uses each scan's pose instead.
     viewpoint: Option<[f64; 3]> = viewpoint, "m", Check::FiniteOrNull;
     /// Fewest inliers a plane needs, and fewest support points a primitive
     /// needs; the cascade stops when the best plane has fewer. gpp2 default
