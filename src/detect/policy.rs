@@ -110,7 +110,9 @@ impl CascadePolicy {
     /// triples: the pool holds laser rings of many scans, thinned to a
     /// voxel grid, and three points of one ring fix a line, not a plane.
     /// Judging every cluster there measured less precise and less
-    /// accurate, and the growing ground tolerance neutral (BENCHMARKS.md).
+    /// accurate, the growing ground tolerance neutral, and clearing
+    /// scattered voxels at a stall less complete and less precise
+    /// (BENCHMARKS.md). Ground is judged from the scan's pose.
     pub const fn scenario_leftovers() -> Self {
         CascadePolicy {
             skip_edge_on_hypotheses: false,
