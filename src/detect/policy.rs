@@ -111,7 +111,7 @@ impl CascadePolicy {
     /// voxel grid, and three points of one ring fix a line, not a plane.
     /// Judging every cluster there measured less precise and less
     /// accurate, the growing ground tolerance neutral, and clearing
-    /// scattered voxels at a stall less complete and less precise
+    /// scattered voxels at a stall finding fewer surfaces, less precisely
     /// (BENCHMARKS.md). Ground is judged from the scan's pose.
     pub const fn scenario_leftovers() -> Self {
         CascadePolicy {
