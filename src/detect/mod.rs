@@ -280,8 +280,16 @@ impl<'p> Detector<'p> {
         let mut cleared = !policy.clear_scattered_on_stall;
         // RMS distance (m) of each accepted support from its plane.
         let mut accepted_rms: Vec<f64> = Vec::new();
-        // Pool positions of rejected clusters that stayed in play (step 6).
-        let mut reprieved = vec![false; pts.len()];
+        // Pool positions of rejected clusters that stayed in play (step 6;
+        // only the plane's other clusters can).
+        let mut reprieved = vec![false; if policy.every_cluster { pts.len() } else { 0 }];
+        let judge = round::Judge {
+            origin,
+            viewpoint,
+            ground,
+            p,
+            policy,
+        };
         for _ in 0..4 * p.max_primitives + 64 {
             if !cleared && rejections >= p.max_rejections {
                 // Stalled: the rounds keep finding planes through clutter.
@@ -327,8 +335,7 @@ impl<'p> Detector<'p> {
                         break;
                     }
                     // 4-5. Refit, outline and judge.
-                    let mut judged =
-                        round::judge(support_pts, origin, viewpoint, ground, p, policy);
+                    let mut judged = judge.judge(support_pts);
                     if k == 0 {
                         step.area = judged.shaped.as_ref().map_or(0.0, |s| s.primitive.area);
                     }
@@ -337,15 +344,7 @@ impl<'p> Detector<'p> {
                     // rest of the cluster stays in play.
                     let mut layer: Option<Vec<u32>> = None;
                     if policy.split_rough_layers && judged.only_too_rough {
-                        if let Some((near, again)) = round::judge_dominant_layer(
-                            &judged,
-                            support_pts,
-                            origin,
-                            viewpoint,
-                            ground,
-                            p,
-                            policy,
-                        ) {
+                        if let Some((near, again)) = judge.dominant_layer(&judged, support_pts) {
                             layer = Some(near.iter().map(|&i| cluster[i]).collect());
                             judged = again;
                         }

@@ -53,7 +53,7 @@
 
 use super::kernels::{self, PlaneF32};
 use crate::floor::GroundRule;
-use crate::geometry::plane::robust_fit;
+use crate::geometry::plane::{robust_fit, smallest_eigen3, Moments};
 use crate::geometry::Plane;
 use crate::hash::Buckets;
 use crate::params::Params;
@@ -399,33 +399,11 @@ impl PlanePool {
             if (self.cell_live[c] as usize) < min_points.max(4) {
                 continue;
             }
-            let centre = self.cell_box[c].0;
-            let (mut s, mut ss) = (DVec3::ZERO, [[0.0f64; 3]; 3]);
-            let mut n = 0.0;
-            for pos in self.voxels.range(c) {
-                if !self.alive[pos] {
-                    continue;
-                }
-                let d = self.cell_pts[pos].as_dvec3() - centre;
-                s += d;
-                n += 1.0;
-                let a = d.to_array();
-                for (i, row) in ss.iter_mut().enumerate() {
-                    for (j, v) in row.iter_mut().enumerate() {
-                        *v += a[i] * a[j];
-                    }
-                }
+            let mut m = Moments::new(self.cell_box[c].0);
+            for pos in self.voxels.range(c).filter(|&pos| self.alive[pos]) {
+                m.push(self.cell_pts[pos].as_dvec3());
             }
-            let m = s / n;
-            let ma = m.to_array();
-            let mut cov = [[0.0f64; 3]; 3];
-            for (i, row) in cov.iter_mut().enumerate() {
-                for (j, v) in row.iter_mut().enumerate() {
-                    *v = ss[i][j] / n - ma[i] * ma[j];
-                }
-            }
-            let flat =
-                crate::geometry::plane::smallest_eigen3(cov).is_none_or(|(l, _)| l[0] <= max_var);
+            let flat = smallest_eigen3(m.covariance()).is_none_or(|(l, _)| l[0] <= max_var);
             if !flat {
                 out.extend(
                     self.voxels

@@ -134,73 +134,82 @@ pub(crate) struct Judged {
     pub(crate) only_too_rough: bool,
 }
 
-/// PCA refit, frame, outline, then the acceptance tests: area, width and
-/// solidity ([`Primitive::acceptable`](crate::primitive::Primitive::acceptable)),
-/// roughness, not a plane seen edge-on, normal consistency.
-pub(crate) fn judge(
-    support_pts: &[Vec3],
-    origin: DVec3,
-    viewpoint: DVec3,
-    ground: GroundRule,
-    p: &Params,
-    policy: &CascadePolicy,
-) -> Judged {
-    let shaped = shape(
-        origin,
-        support_pts,
-        p,
-        viewpoint,
-        ground,
-        policy.bridge_ring_gaps,
-    );
-    let rest_ok = |s: &Shaped| {
-        s.primitive.acceptable(p)
-            && !(policy.reject_edge_on_candidates && seen_edge_on(s, viewpoint, p))
-            && s.consistency(origin, support_pts, p) >= p.min_normal_consistency
-    };
-    let smooth = shaped
-        .as_ref()
-        .is_some_and(|s| s.roughness <= p.max_roughness);
-    let rest = shaped.as_ref().is_some_and(rest_ok);
-    Judged {
-        shaped,
-        accepted: smooth && rest,
-        only_too_rough: !smooth && rest,
-    }
+/// What judging a candidate needs besides its points: where the cloud and
+/// the sensor are, what is ground, the parameters and the policy.
+#[derive(Clone, Copy)]
+pub(crate) struct Judge<'a> {
+    /// The cloud's origin (candidate points are local to it).
+    pub(crate) origin: DVec3,
+    /// The sensor (world).
+    pub(crate) viewpoint: DVec3,
+    pub(crate) ground: GroundRule<'a>,
+    pub(crate) p: &'a Params,
+    pub(crate) policy: &'a CascadePolicy,
 }
 
-/// A candidate that failed only roughness ([`Judged::only_too_rough`]),
-/// judged again as the layer that holds more of its points, when its
-/// points lie in two layers ([`two_layers`]): the points within the inlier
-/// distance of that layer's plane. `Some((positions in support_pts,
-/// judged))` when the layer is accepted; the rest of the candidate stays in
-/// play.
-pub(crate) fn judge_dominant_layer(
-    rough: &Judged,
-    support_pts: &[Vec3],
-    origin: DVec3,
-    viewpoint: DVec3,
-    ground: GroundRule,
-    p: &Params,
-    policy: &CascadePolicy,
-) -> Option<(Vec<usize>, Judged)> {
-    let s = rough.shaped.as_ref()?;
-    let world: Vec<DVec3> = support_pts.iter().map(|q| origin + q.as_dvec3()).collect();
-    let distance = p.surface(s.primitive.ground).distance;
-    // The layers are found on every k-th point (at most about 50,000): a
-    // plane needs no more, and a road's candidate can hold a million.
-    let every = world.len().div_ceil(50_000).max(1);
-    let sample: Vec<DVec3> = world.iter().copied().step_by(every).collect();
-    let layer = two_layers(&s.primitive.plane, &sample, distance)?;
-    let near: Vec<usize> = (0..world.len())
-        .filter(|&i| layer.signed_distance(world[i]).abs() <= distance)
-        .collect();
-    if near.len() < p.min_inliers || near.len() == world.len() {
-        return None;
+impl Judge<'_> {
+    /// PCA refit, frame, outline, then the acceptance tests: area, width
+    /// and solidity
+    /// ([`Primitive::acceptable`](crate::primitive::Primitive::acceptable)),
+    /// roughness, not a plane seen edge-on, normal consistency.
+    pub(crate) fn judge(&self, support_pts: &[Vec3]) -> Judged {
+        let (p, viewpoint) = (self.p, self.viewpoint);
+        let shaped = shape(
+            self.origin,
+            support_pts,
+            p,
+            viewpoint,
+            self.ground,
+            self.policy.bridge_ring_gaps,
+        );
+        let rest_ok = |s: &Shaped| {
+            s.primitive.acceptable(p)
+                && !(self.policy.reject_edge_on_candidates && seen_edge_on(s, viewpoint, p))
+                && s.consistency(self.origin, support_pts, p) >= p.min_normal_consistency
+        };
+        let smooth = shaped
+            .as_ref()
+            .is_some_and(|s| s.roughness <= p.max_roughness);
+        let rest = shaped.as_ref().is_some_and(rest_ok);
+        Judged {
+            shaped,
+            accepted: smooth && rest,
+            only_too_rough: !smooth && rest,
+        }
     }
-    let pts: Vec<Vec3> = near.iter().map(|&i| support_pts[i]).collect();
-    let again = judge(&pts, origin, viewpoint, ground, p, policy);
-    again.accepted.then_some((near, again))
+
+    /// A candidate that failed only roughness ([`Judged::only_too_rough`]),
+    /// judged again as the layer that holds more of its points, when its
+    /// points lie in two layers ([`two_layers`]): the points within the
+    /// inlier distance of that layer's plane. `Some((positions in
+    /// support_pts, judged))` when the layer is accepted; the rest of the
+    /// candidate stays in play.
+    pub(crate) fn dominant_layer(
+        &self,
+        rough: &Judged,
+        support_pts: &[Vec3],
+    ) -> Option<(Vec<usize>, Judged)> {
+        let s = rough.shaped.as_ref()?;
+        let world: Vec<DVec3> = support_pts
+            .iter()
+            .map(|q| self.origin + q.as_dvec3())
+            .collect();
+        let distance = self.p.surface(s.primitive.ground).distance;
+        // The layers are found on every k-th point (at most about 50,000):
+        // a plane needs no more, and a road's candidate can hold a million.
+        let every = world.len().div_ceil(50_000).max(1);
+        let sample: Vec<DVec3> = world.iter().copied().step_by(every).collect();
+        let layer = two_layers(&s.primitive.plane, &sample, distance)?;
+        let near: Vec<usize> = (0..world.len())
+            .filter(|&i| layer.signed_distance(world[i]).abs() <= distance)
+            .collect();
+        if near.len() < self.p.min_inliers || near.len() == world.len() {
+            return None;
+        }
+        let pts: Vec<Vec3> = near.iter().map(|&i| support_pts[i]).collect();
+        let again = self.judge(&pts);
+        again.accepted.then_some((near, again))
+    }
 }
 
 /// The plane of the layer holding more of `world`, when the points lie in
