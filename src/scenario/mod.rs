@@ -9,6 +9,7 @@ mod expand;
 mod index;
 mod pool;
 pub mod snapshot;
+mod surfaces;
 pub use crate::merge::MergeEvent;
 
 use crate::clock;
@@ -23,6 +24,7 @@ use glam::{DMat4, DVec3};
 use index::ScanIndex;
 use pool::Pool;
 use serde::{Deserialize, Serialize};
+use surfaces::Surfaces;
 
 /// Longest snapshot text [`Scenario::from_json`] reads (bytes; 256 MiB):
 /// restoring one takes a few times its size in memory, which must fit in
@@ -268,9 +270,9 @@ impl Scenario {
         report.explained_from_pool = alive[n..].iter().filter(|&&a| !a).count();
         if !empty {
             near.extend_from_slice(&report.added);
-            let seen = SeenSurfaces::new(&self.primitives, &near, p);
+            let seen = Surfaces::new(&self.primitives, &near, |q| surfaces::seen_slack(q, p));
             self.pool
-                .carry(cloud, n, &alive, &selection, scan, p, &|w| seen.holds(w));
+                .carry(cloud, n, &alive, &selection, scan, p, &|w| seen.holds(w, p));
         }
         report.pool_points = self.pool.len();
         labels.truncate(n);
@@ -329,89 +331,4 @@ impl Scenario {
         s.pool.validate(s.scans)?;
         Ok(s)
     }
-}
-
-/// Side of the cells [`SeenSurfaces`] files polygons under (m).
-const SEEN_CELL: f64 = 16.0;
-
-/// Most cells a polygon is filed under in [`SeenSurfaces`]; a larger one is
-/// tested for every point.
-const SEEN_MAX_CELLS: i64 = 4096;
-
-/// The polygons within reach of a scan (those its expansion visited, and
-/// those its detection added), filed by the cells that their outline's box,
-/// grown by the test's slack, covers: so that [`SeenSurfaces::holds`] costs
-/// what the scan saw, not what the map holds.
-struct SeenSurfaces<'a> {
-    prims: &'a [Primitive],
-    params: &'a Params,
-    cells: crate::hash::GridMap<[i64; 3], Vec<usize>>,
-    wide: Vec<usize>,
-}
-
-impl<'a> SeenSurfaces<'a> {
-    fn new(prims: &'a [Primitive], ids: &[u32], params: &'a Params) -> Self {
-        let mut seen = SeenSurfaces {
-            prims,
-            params,
-            cells: Default::default(),
-            wide: Vec::new(),
-        };
-        for &id in ids {
-            let Ok(k) = prims.binary_search_by_key(&id, |q| q.id) else {
-                continue;
-            };
-            let prim = &prims[k];
-            let (lo, hi) = crate::geometry::bounds(&prim.vertices());
-            let pad = DVec3::splat(seen.slack(prim));
-            let (a, b) = (seen_cell(lo - pad), seen_cell(hi + pad));
-            let count = (0..3).fold(1i64, |c, i| {
-                c.saturating_mul(b[i].saturating_sub(a[i]).saturating_add(1))
-            });
-            if !(lo.is_finite() && hi.is_finite()) || count > SEEN_MAX_CELLS {
-                seen.wide.push(k);
-                continue;
-            }
-            for x in a[0]..=b[0] {
-                for y in a[1]..=b[1] {
-                    for z in a[2]..=b[2] {
-                        seen.cells.entry([x, y, z]).or_default().push(k);
-                    }
-                }
-            }
-        }
-        seen
-    }
-
-    /// Two expansion gates (`expandAcross`) of `prim`'s kind (m).
-    fn slack(&self, prim: &Primitive) -> f64 {
-        2.0 * self.params.surface(prim.ground).expand_across
-    }
-
-    /// Is world point `w` on one of these polygons, seen through an
-    /// imperfect pose: inside its outline and within two expansion gates of
-    /// its plane? Expansion takes points within one gate; a pose a few
-    /// centimetres or a tenth of a degree off puts a surface's points just
-    /// beyond it. Left in the pool, such points would add up, scan after
-    /// scan, to a second layer of the same surface; so the pool does not
-    /// keep them (the scan's detection still sees them, as without a pool).
-    fn holds(&self, w: DVec3) -> bool {
-        let cell = self
-            .cells
-            .get(&seen_cell(w))
-            .map_or(&[][..], |v| v.as_slice());
-        self.wide.iter().chain(cell).any(|&k| {
-            let prim = &self.prims[k];
-            prim.plane.signed_distance(w).abs() <= self.slack(prim)
-                && crate::geometry::polygon::contains(&prim.outline, prim.frame.to_local(w))
-        })
-    }
-}
-
-fn seen_cell(p: DVec3) -> [i64; 3] {
-    [
-        crate::geometry::floor_i64(p.x / SEEN_CELL),
-        crate::geometry::floor_i64(p.y / SEEN_CELL),
-        crate::geometry::floor_i64(p.z / SEEN_CELL),
-    ]
 }

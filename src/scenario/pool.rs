@@ -155,7 +155,7 @@ impl Pool {
     /// voxel, then the pool points of `sel` still alive and younger than
     /// `poolScans` scans, cut at `poolMaxPoints`. A point for which `known`
     /// is true (it lies on a known polygon, a little off its plane) is not
-    /// kept (see `SeenSurfaces::holds` in the scenario).
+    /// kept (see `Surfaces::holds` in `scenario/surfaces.rs`).
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn carry(
         &mut self,
