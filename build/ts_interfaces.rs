@@ -64,6 +64,13 @@ const INTERFACES: &[Interface] = &[
         flatten: &[],
     },
     Interface {
+        ts: "Alignment",
+        file: "src/scenario/mod.rs",
+        rust: "Alignment",
+        optional: false,
+        flatten: &[],
+    },
+    Interface {
         ts: "ScanReport",
         file: "src/scenario/mod.rs",
         rust: "ScanReport",

@@ -209,6 +209,21 @@ pub struct Cloud {
 }
 
 impl Cloud {
+    /// This cloud moved by the rigid world transform `m`, around the same
+    /// origin.
+    pub fn transformed(&self, m: &DMat4) -> Cloud {
+        let r = glam::DMat3::from_mat4(*m);
+        let t = m.transform_point3(self.origin) - self.origin;
+        Cloud {
+            origin: self.origin,
+            points: self
+                .points
+                .iter()
+                .map(|p| (r * p.as_dvec3() + t).as_vec3())
+                .collect(),
+        }
+    }
+
     /// From world coordinates in f64. The origin is the centre of the bounding
     /// box rounded to whole metres, so translated copies of a cloud get the
     /// same local coordinates.

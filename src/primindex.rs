@@ -242,10 +242,16 @@ impl PrimIndex {
     /// Every primitive whose expansion could take a point of `cloud`
     /// (sorted ids; a superset, never missing one).
     pub fn near_cloud(&self, cloud: &Cloud) -> Vec<u32> {
+        self.near_points(cloud.points.iter().map(|p| cloud.origin + p.as_dvec3()))
+    }
+
+    /// Every primitive whose expansion could take one of the world points
+    /// `points` (sorted ids; a superset, never missing one).
+    pub fn near_points(&self, points: impl Iterator<Item = DVec3>) -> Vec<u32> {
         let mut keys: Vec<[i64; 3]> = Vec::new();
         let mut last = None;
-        for p in &cloud.points {
-            let c = cell_of(cloud.origin + p.as_dvec3());
+        for p in points {
+            let c = cell_of(p);
             // Consecutive points of a scan mostly share a cell.
             if last != Some(c) {
                 keys.push(c);

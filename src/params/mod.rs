@@ -121,6 +121,10 @@ pub struct Params {
     pub max_work: u64,
     /// `expansion`.
     pub expansion: bool,
+    /// `alignScans`.
+    pub align_scans: bool,
+    /// `alignReach` (m).
+    pub align_reach: f64,
     /// `mergeAngle` (deg).
     pub merge_angle: f64,
     /// `mergeDistance` (m).
@@ -257,6 +261,8 @@ impl Params {
             max_rejections: 10,
             max_work: 2_000_000_000,
             expansion: true,
+            align_scans: true,
+            align_reach: 0.3,
             merge_angle: 8.0,
             merge_distance: 0.08,
             merge_gap: 0.3,

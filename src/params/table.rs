@@ -120,6 +120,17 @@ options! {
     /// Grow existing primitives with each scan before detecting new ones.
     /// Default true; false gives the paper's "without expansion" mode.
     expansion: bool = expansion, "", Check::Any;
+    /// Before expanding, align each scan to the map: a point-to-plane fit
+    /// of a sample of its points to the polygons they lie on refines its
+    /// pose (rotation about the sensor and translation), in the directions
+    /// those polygons pin down. The correction carries over to the next
+    /// scan. It catches pose drift of up to `alignReach` a scan; exact
+    /// poses are left exactly as given. Needs `expansion`. Default true.
+    align_scans: bool = align_scans, "", Check::Any;
+    /// Largest pose error a scan's alignment corrects (m, at 10 m from the
+    /// sensor for rotations): the first gate of its point-to-plane pairs.
+    /// Default 0.3.
+    align_reach: f64 = align_reach, "m", Check::Positive(10.0);
     /// Perpendicular gate of expansion, ground (m): at most this, and at
     /// most three times the primitive's own RMS residual (never below
     /// 0.03 m), so a primitive takes what continues it, not the edges of

@@ -5,6 +5,7 @@
 //! expand every existing primitive in a cascade, detect new primitives on
 //! what is left, merge primitives that grew into each other, report.
 
+mod align;
 mod expand;
 mod index;
 mod pool;
@@ -37,6 +38,9 @@ const INDEX_VOXEL: f64 = 1.0;
 /// Time per stage of one scan (ms).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct StageTimes {
+    /// Aligning the scan to the map.
+    #[serde(default)]
+    pub alignment: f64,
     /// Expanding existing primitives.
     pub expansion: f64,
     /// Detecting new ones on the leftover points.
@@ -47,6 +51,46 @@ pub struct StageTimes {
     pub total: f64,
 }
 
+/// How a scan was aligned to the map before expansion (`alignScans`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "camelCase")]
+pub struct Alignment {
+    /// Point-to-polygon pairs of the fit's last iteration; 0 when the scan
+    /// was not aligned (the first scan, `alignScans` or `expansion` off, no
+    /// known polygon in view).
+    pub pairs: usize,
+    /// How many of the pose's six directions (three turns, three shifts)
+    /// the pairs pinned down; along the others the scan kept the last
+    /// scan's correction.
+    pub constrained: usize,
+    /// Whether this scan's fit changed the correction (fewer than 100
+    /// pairs, a step beyond `alignReach`, or one that moves no point within
+    /// 50 m of the sensor by 2 mm, change nothing).
+    pub applied: bool,
+    /// How far this scan's fit moved the sensor (m).
+    pub shift: f64,
+    /// How far it turned the scan (deg).
+    pub turn: f64,
+    /// The correction the scan's world points were moved by (the last
+    /// scan's, refined by this scan's fit): a rigid 4 x 4 transform,
+    /// column-major like the poses; the scan's corrected pose is this
+    /// times the pose given. The identity while poses need no correction.
+    pub correction: [f64; 16],
+}
+
+impl Default for Alignment {
+    fn default() -> Self {
+        Alignment {
+            pairs: 0,
+            constrained: 0,
+            applied: false,
+            shift: 0.0,
+            turn: 0.0,
+            correction: DMat4::IDENTITY.to_cols_array(),
+        }
+    }
+}
+
 /// What one scan did to the scenario.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "camelCase")]
@@ -55,6 +99,8 @@ pub struct ScanReport {
     pub scan: u64,
     /// Points in the scan.
     pub points: usize,
+    /// How the scan was aligned to the map before expansion.
+    pub alignment: Alignment,
     /// Points taken by the expansion of existing primitives.
     pub explained_by_expansion: usize,
     /// Points given to detection (the rest).
@@ -98,6 +144,10 @@ pub struct Scenario {
     /// Unexplained points of the last scans (`poolScans`), world frame.
     #[serde(default)]
     pool: Pool,
+    /// The correction of the last scan's pose found by aligning it to the
+    /// map (`alignScans`): world from the frame the poses give.
+    #[serde(default)]
+    correction: DMat4,
     #[serde(skip)]
     last_labels: Vec<u32>,
     /// Where the primitives are (derived, rebuilt after a restore).
@@ -115,6 +165,7 @@ impl Scenario {
             next_id: 0,
             scans: 0,
             pool: Pool::default(),
+            correction: DMat4::IDENTITY,
             last_labels: Vec::new(),
             index: PrimIndex::default(),
         })
@@ -133,6 +184,12 @@ impl Scenario {
     /// Scans processed so far.
     pub fn scans(&self) -> u64 {
         self.scans
+    }
+
+    /// The correction the last scan was moved by, in the world frame (see
+    /// [`Alignment::correction`]); the identity before any.
+    pub fn correction(&self) -> DMat4 {
+        self.correction
     }
 
     /// Per point of the last scan: the id of the primitive that explained it
@@ -174,9 +231,14 @@ impl Scenario {
     /// (world position, used to orient new normals). `t0` is the clock
     /// reading the total time counts from.
     pub fn add_cloud(&mut self, scan_cloud: &Cloud, sensor: DVec3, t0: f64) -> ScanReport {
-        let p = &self.params;
         let scan = self.scans;
         let n = scan_cloud.len();
+        // 0. Alignment to the map: the scan moves by the correction.
+        let ta = clock::now_ms();
+        let (moved, sensor, alignment) = self.align(scan_cloud, sensor);
+        let scan_cloud = moved.as_ref().unwrap_or(scan_cloud);
+        let align_ms = clock::now_ms() - ta;
+        let p = &self.params;
         // The scan's points, then the pool's: expansion and detection see
         // both, the report and the labels count the scan's.
         // An empty scan brings no evidence: it changes nothing (the pool's
@@ -193,8 +255,10 @@ impl Scenario {
         let mut report = ScanReport {
             scan,
             points: n,
+            alignment,
             ..ScanReport::default()
         };
+        report.time_ms.alignment = align_ms;
 
         // 1. Expansion of existing primitives, in a cascade (id order).
         let te = clock::now_ms();
@@ -304,6 +368,43 @@ impl Scenario {
         report
     }
 
+    /// Move `scan` (world frame, seen from `sensor`) by the last scan's
+    /// correction, then align it to the polygons in view and keep the
+    /// refined correction (`align.rs`). Returns the moved scan (`None`
+    /// when the correction is the identity), the moved sensor and the
+    /// report.
+    fn align(&mut self, scan: &Cloud, sensor: DVec3) -> (Option<Cloud>, DVec3, Alignment) {
+        let p = &self.params;
+        let mut report = Alignment::default();
+        if !(p.align_scans && p.expansion) || scan.is_empty() {
+            return (None, sensor, report);
+        }
+        if !self.primitives.is_empty() {
+            self.index.ensure(&self.primitives, p);
+            let fit = align::align(
+                scan,
+                sensor,
+                &self.correction,
+                &self.primitives,
+                &self.index,
+                p,
+            );
+            report.pairs = fit.pairs;
+            report.constrained = fit.constrained;
+            if fit.applied {
+                report.applied = true;
+                report.shift = fit.shift;
+                report.turn = fit.turn.to_degrees();
+                self.correction = fit.step * self.correction;
+            }
+        }
+        let moved =
+            (self.correction != DMat4::IDENTITY).then(|| scan.transformed(&self.correction));
+        let at = self.correction.transform_point3(sensor);
+        report.correction = self.correction.to_cols_array();
+        (moved, at, report)
+    }
+
     /// The whole state as JSON (parameters included). Restoring it with
     /// [`Scenario::from_json`] and continuing gives exactly the result of
     /// not stopping.
@@ -329,6 +430,17 @@ impl Scenario {
         snapshot::check(&s.primitives, s.next_id, s.scans, &s.params)
             .map_err(|e| Error::Invalid(format!("not a polyscene snapshot: {e}")))?;
         s.pool.validate(s.scans)?;
+        crate::cloud::check_rigid(&s.correction).map_err(|e| {
+            Error::Invalid(format!(
+                "not a polyscene snapshot: its pose correction is no rigid transform: {e}"
+            ))
+        })?;
+        if s.correction.w_axis.truncate().abs().max_element() > crate::cloud::MAX_COORDINATE {
+            return Err(Error::Invalid(format!(
+                "not a polyscene snapshot: its pose correction moves points by more than {} m",
+                crate::cloud::MAX_COORDINATE
+            )));
+        }
         Ok(s)
     }
 }

@@ -9,7 +9,7 @@ import { ps, psSim, repoRoot } from "./common.mjs";
 import { optionDocs, documentedDefault, sameValue, optionsTable } from "../../scripts/gen-js-docs.mjs";
 
 const POLYGON_KEYS = ["id", "normal", "offset", "vertices", "area", "support", "density", "ground", "bornScan", "lastScan"];
-const REPORT_KEYS = ["scan", "points", "explainedByExpansion", "sentToDetection", "explainedByDetection", "poolToDetection", "explainedFromPool", "poolPoints", "added", "grown", "merged", "polygonCount", "totalArea", "timeMs"];
+const REPORT_KEYS = ["scan", "points", "alignment", "explainedByExpansion", "sentToDetection", "explainedByDetection", "poolToDetection", "explainedFromPool", "poolPoints", "added", "grown", "merged", "polygonCount", "totalArea", "timeMs"];
 
 test("exports: the simulator in its own module (polyscene/sim), not in the main one", () => {
   for (const name of ["Scenario", "detect", "detectFlat", "detectWithProgress", "defaultOptions", "version"]) {
@@ -58,7 +58,7 @@ test("reports, polygons and labels of a street drive", () => {
     const { points, pose, stride } = sim.next();
     report = scenario.addScan(points, { stride, pose });
     assert.deepEqual(Object.keys(report), REPORT_KEYS);
-    assert.deepEqual(Object.keys(report.timeMs).sort(), ["detection", "expansion", "merge", "total"]);
+    assert.deepEqual(Object.keys(report.timeMs).sort(), ["alignment", "detection", "expansion", "merge", "total"]);
     assert.equal(report.scan, k);
     assert.equal(report.points, points.length / 4);
     assert.equal(report.explainedByExpansion + report.sentToDetection, report.points);
@@ -209,6 +209,7 @@ test("the .d.ts interfaces have the objects' keys and typed arrays (both come fr
   const report = s.addScan(scan.points, { stride: 4, pose: scan.pose });
   check("ScanReport", report);
   check("StageTimes", report.timeMs);
+  check("Alignment", report.alignment);
   check("Polygon", s.polygons()[0]);
   check("Mesh", s.mesh());
   for (const m of report.merged) check("MergeEvent", m);
