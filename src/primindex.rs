@@ -29,7 +29,6 @@
 //!   the outline's bounding box grown by that padding plus a metre, so a
 //!   pair that can merge shares a cell of the query around one outline box.
 
-use crate::cloud::Cloud;
 use crate::geometry::{bounds, floor_i64};
 use crate::hash::GridMap;
 use crate::params::Params;
@@ -239,10 +238,24 @@ impl PrimIndex {
         ids
     }
 
-    /// Every primitive whose expansion could take a point of `cloud`
-    /// (sorted ids; a superset, never missing one).
-    pub fn near_cloud(&self, cloud: &Cloud) -> Vec<u32> {
-        self.near_points(cloud.points.iter().map(|p| cloud.origin + p.as_dvec3()))
+    /// Every primitive whose expansion could take a point of a cloud
+    /// (sorted ids; a superset, never missing one), from the cloud's
+    /// occupied voxels (a few times fewer than its points): `voxels` are integer
+    /// coordinates of cubes of side `side` in the frame whose origin is
+    /// world point `origin`. Every cell a voxel's cube touches counts (and
+    /// those within a micrometre of it, for the rounding of the voxel
+    /// coordinates).
+    pub fn near_voxels(&self, origin: DVec3, voxels: &[[i64; 3]], side: f64) -> Vec<u32> {
+        let mut keys: Vec<[i64; 3]> = Vec::new();
+        let eps = DVec3::splat(1e-6);
+        for c in voxels {
+            let lo = origin + DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64) * side;
+            let (a, b) = (cell_of(lo - eps), cell_of(lo + DVec3::splat(side) + eps));
+            each_cell(a, b, |k| keys.push(k));
+        }
+        keys.sort_unstable();
+        keys.dedup();
+        self.gather(keys.into_iter())
     }
 
     /// Every primitive whose expansion could take one of the world points

@@ -20,6 +20,8 @@ pub struct ScanIndex {
     /// hash lookup. Empty with dense ids, which are as cheap.
     occ: Vec<u64>,
     dims: [usize; 3],
+    /// Every occupied voxel's integer coordinates.
+    voxels: Vec<[i64; 3]>,
 }
 
 /// Largest voxel box that gets a dense occupancy bitmap (16 Mbit = 2 MB).
@@ -53,8 +55,11 @@ impl ScanIndex {
                 }
             }
         }
+        let mut voxels = v.coords;
+        voxels.extend_from_slice(&v.aliased);
         ScanIndex {
             voxel,
+            voxels,
             visited: vec![0; cells],
             ids: v.ids,
             buckets,
@@ -63,6 +68,12 @@ impl ScanIndex {
             occ,
             dims,
         }
+    }
+
+    /// The voxels that hold points: integer coordinates `c`, the voxel
+    /// spanning `c * side ..= (c + 1) * side` in local coordinates.
+    pub fn voxels(&self) -> (&[[i64; 3]], f64) {
+        (&self.voxels, self.voxel)
     }
 
     /// Might voxel `c` hold points? (False only when it surely does not.)

@@ -272,7 +272,8 @@ impl Scenario {
             let mut scratch = expand::Scratch::default();
             // Only the primitives a point of this scan could reach (exact:
             // see `primindex`), in id order.
-            near = self.index.near_cloud(cloud);
+            let (voxels, side) = index.voxels();
+            near = self.index.near_voxels(cloud.origin, voxels, side);
             for &id in &near {
                 let Ok(k) = self.primitives.binary_search_by_key(&id, |q| q.id) else {
                     continue;
