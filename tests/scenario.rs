@@ -498,7 +498,7 @@ fn memory_is_bounded_by_the_mapped_area_not_the_scans() {
 
 /// A drive whose poses drift, as real odometry does: each scan adds up to
 /// 3 cm and 0.15 degrees (about each axis, turning about the world origin,
-/// so the sensor 50-100 m from it moves 15-25 cm a scan), bounded at 12 cm
+/// so the sensor, up to 59 m from it, moves up to 15 cm more a scan), bounded at 12 cm
 /// and 0.6 degrees. A surface seen again through a pose off must grow or
 /// merge, not duplicate. Measured: 141 polygons against 135 without drift,
 /// no duplicate pair (137 and none with `alignScans` off: the pool and the
