@@ -63,8 +63,9 @@ pub const MIN_CONSTRAINT: f64 = 25.0;
 
 /// A refinement that moves no point within 50 m of the sensor by more than
 /// this (m) is not applied: expansion's gate (at least 3 cm) absorbs such
-/// an error, and below it the fit measures the map's own flaws (a crowned
-/// road fitted by one plane, seen from one lane) more than the pose.
+/// an error, and below it the fit measures the map's own small errors more
+/// than the pose (with exact poses, fits of 1-3 cm at 50 m turned the
+/// simulated street's scans by 0.01-0.03 degrees).
 pub const DEADBAND: f64 = 0.03;
 
 /// Range the deadband is measured at (m).

@@ -227,7 +227,7 @@ class App {
     this.#setStat('stat-expansion', share, fmt.pct(share));
     this.#setStat('stat-scan', m.index + 1, `scan ${m.index + 1} / ${m.total} · ${fmt.int(r.points)} points`);
     $('stat-stages').textContent =
-      `expansion ${fmt.ms2(r.timeMs.expansion)} · detection ${fmt.ms2(r.timeMs.detection)} · merge ${fmt.ms2(r.timeMs.merge)} ms`;
+      `alignment ${fmt.ms2(r.timeMs.alignment)} · expansion ${fmt.ms2(r.timeMs.expansion)} · detection ${fmt.ms2(r.timeMs.detection)} · merge ${fmt.ms2(r.timeMs.merge)} ms`;
     $('progress-fill').style.width = `${(100 * (m.index + 1)) / m.total}%`;
     this.sparks[0].push(r.polygonCount);
     this.sparks[1].push(r.sentToDetection);
