@@ -869,18 +869,25 @@ fn placed_off(s: &Scenario, pose: &DMat4, p: DVec3) -> DVec3 {
     (s.correction() * *pose).transform_point3(p) - p
 }
 
+/// The street box (`end`: with its end wall) mapped from the true pose,
+/// then seen again (fresh noise) through a pose 5 cm and 0.1-0.15 degrees
+/// off: the scenario, the second scan's report and the pose error.
+fn seen_again_through_an_error(end: bool) -> (Scenario, polyscene::ScanReport, DMat4) {
+    let error = pose_error(DVec3::new(0.05, -0.04, 0.03), DVec3::new(0.1, -0.1, 0.15));
+    let mut s = Scenario::new(Params::gpp2()).unwrap();
+    s.add_scan(&street_box(end, 1), 3, &DMat4::IDENTITY)
+        .unwrap();
+    let r = s.add_scan(&street_box(end, 2), 3, &error).unwrap();
+    (s, r, error)
+}
+
 #[test]
 fn alignment_undoes_a_pose_error_where_the_scene_pins_it_down() {
-    // Scan 0 maps the box; scan 1 (fresh noise) arrives through a pose 5 cm
-    // and 0.1-0.15 degrees off. With the end wall every direction is
+    // With the end wall every direction is
     // pinned: the corrected placement is within 5 mm everywhere in the
     // box. Without alignment the 5 cm error alone would exceed the 3-8 cm
     // expansion gate at the far end.
-    let error = pose_error(DVec3::new(0.05, -0.04, 0.03), DVec3::new(0.1, -0.1, 0.15));
-    let mut s = Scenario::new(Params::gpp2()).unwrap();
-    s.add_scan(&street_box(true, 1), 3, &DMat4::IDENTITY)
-        .unwrap();
-    let r = s.add_scan(&street_box(true, 2), 3, &error).unwrap();
+    let (s, r, error) = seen_again_through_an_error(true);
     let a = &r.alignment;
     assert!(a.applied && a.constrained == 6, "{a:?}");
     for p in [
@@ -908,11 +915,7 @@ fn alignment_leaves_alone_the_directions_nothing_pins_down() {
     // Without the end wall nothing tells where along the street the scan
     // is: the fit corrects the other five directions and keeps the given
     // position along x (it does not slide), and says so.
-    let error = pose_error(DVec3::new(0.05, -0.04, 0.03), DVec3::new(0.1, -0.1, 0.15));
-    let mut s = Scenario::new(Params::gpp2()).unwrap();
-    s.add_scan(&street_box(false, 1), 3, &DMat4::IDENTITY)
-        .unwrap();
-    let r = s.add_scan(&street_box(false, 2), 3, &error).unwrap();
+    let (s, r, error) = seen_again_through_an_error(false);
     assert!(
         r.alignment.applied && r.alignment.constrained == 5,
         "{:?}",
