@@ -11,8 +11,7 @@
 //! The method is point-to-plane Gauss-Newton, the linearised form of
 //! Chen and Medioni's ICP, with the map's polygons as the planes:
 //! 1. *Prior.* The scan starts at the correction found for the last scan
-//!    (drift changes little from one scan to the next), applied by the
-//!    caller.
+//!    (drift changes little from one scan to the next).
 //! 2. *Sample.* Up to [`SAMPLE`] points of the scan, evenly spaced in scan
 //!    order.
 //! 3. *Pairs.* Each sampled point is paired with the nearest polygon plane
@@ -102,10 +101,10 @@ impl Fit {
     }
 }
 
-/// Refine the placement of the world-frame scan `cloud`, seen from
-/// `sensor`, already moved by `prior`, against the polygons `prims`
-/// (id-sorted, filed in `index`). The refinement turns about the moved
-/// sensor.
+/// Refine the placement of the world-frame scan `cloud` (as given, seen
+/// from `sensor`), starting from the correction `prior`, against the
+/// polygons `prims` (id-sorted, filed in `index`). The refinement turns
+/// about the sensor moved by `prior`.
 // Matrix code reads as the formulas with indices.
 #[allow(clippy::needless_range_loop)]
 pub(crate) fn align(
@@ -136,8 +135,9 @@ pub(crate) fn align(
     let ids = index.near_points(world.iter().copied());
     let surfaces = Surfaces::new(prims, &ids, |_| 2.0 * reach + 1.0);
     // Each sample's candidate polygons: within twice the first gate of
-    // their plane (the step never moves a point farther than that and
-    // keeps it).
+    // their plane (a kept step moves a point 10 m from the sensor by at
+    // most the first gate; a farther point that leaves this band only
+    // loses its pair).
     let mut samples: Vec<DVec3> = Vec::with_capacity(world.len());
     let mut start: Vec<u32> = vec![0];
     let mut cand: Vec<u32> = Vec::new();

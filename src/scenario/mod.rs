@@ -2,8 +2,9 @@
 //! list of primitives (the paper's Algorithm 2, plus merging).
 //!
 //! Per scan: transform to the world frame (f64, around a local origin),
-//! expand every existing primitive in a cascade, detect new primitives on
-//! what is left, merge primitives that grew into each other, report.
+//! align it to the map (`align.rs`), expand every existing primitive in a
+//! cascade, detect new primitives on what is left, merge primitives that
+//! grew into each other, report.
 
 mod align;
 mod expand;
@@ -65,7 +66,7 @@ pub struct Alignment {
     pub constrained: usize,
     /// Whether this scan's fit changed the correction (fewer than 100
     /// pairs, a step beyond `alignReach`, or one that moves no point within
-    /// 50 m of the sensor by 2 mm, change nothing).
+    /// 50 m of the sensor by more than 3 cm, change nothing).
     pub applied: bool,
     /// How far this scan's fit moved the sensor (m).
     pub shift: f64,
@@ -200,7 +201,8 @@ impl Scenario {
     }
 
     /// Add a scan: `points` interleaved with `stride` 3 or 4 in the sensor
-    /// frame, `pose` the world-from-sensor rigid transform. Float32 points
+    /// frame, `pose` the world-from-sensor rigid transform (refined against
+    /// the map with `alignScans`: see [`Alignment`]). Float32 points
     /// must lie within [`MAX_F32_COORDINATE`](crate::cloud::MAX_F32_COORDINATE)
     /// of the sensor; points in map coordinates go through
     /// [`Scenario::add_scan_f64`].
@@ -229,7 +231,9 @@ impl Scenario {
 
     /// Add a scan already in the world frame (`cloud`), seen from `sensor`
     /// (world position, used to orient new normals). `t0` is the clock
-    /// reading the total time counts from.
+    /// reading the total time counts from. With `alignScans` the scan is
+    /// first moved by the correction its alignment to the map finds
+    /// ([`Alignment`]).
     pub fn add_cloud(&mut self, scan_cloud: &Cloud, sensor: DVec3, t0: f64) -> ScanReport {
         let scan = self.scans;
         let n = scan_cloud.len();
@@ -377,7 +381,11 @@ impl Scenario {
     fn align(&mut self, scan: &Cloud, sensor: DVec3) -> (Option<Cloud>, DVec3, Alignment) {
         let p = &self.params;
         let mut report = Alignment::default();
-        if !(p.align_scans && p.expansion) || scan.is_empty() {
+        if !(p.align_scans && p.expansion) {
+            return (None, sensor, report);
+        }
+        report.correction = self.correction.to_cols_array();
+        if scan.is_empty() {
             return (None, sensor, report);
         }
         if !self.primitives.is_empty() {
