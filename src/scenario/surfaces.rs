@@ -10,6 +10,7 @@ use crate::hash::GridMap;
 use crate::params::Params;
 use crate::primitive::Primitive;
 use glam::DVec3;
+use std::cell::Cell;
 
 /// Side of the cells polygons are filed under (m).
 const CELL: f64 = 16.0;
@@ -18,24 +19,29 @@ const CELL: f64 = 16.0;
 /// every point.
 const MAX_CELLS: i64 = 4096;
 
+/// A cell and the range of [`Surfaces`]'s list that holds its polygons.
+type CellRange = ([i64; 3], (u32, u32));
+
 /// Polygons of a scenario (by position in its id-sorted list), filed under
 /// every cell that their outline's box, grown by a per-polygon slack,
 /// covers.
 pub(crate) struct Surfaces<'a> {
     pub prims: &'a [Primitive],
-    cells: GridMap<[i64; 3], Vec<usize>>,
+    /// Per cell, the range of `items` that holds its polygons.
+    cells: GridMap<[i64; 3], (u32, u32)>,
+    items: Vec<usize>,
     wide: Vec<usize>,
+    /// The last cell looked up and its range: consecutive points of a scan
+    /// mostly share a cell, and the hash lookup was most of a query.
+    last: Cell<Option<CellRange>>,
 }
 
 impl<'a> Surfaces<'a> {
     /// The polygons `ids` of `prims` (id-sorted), each filed with the slack
     /// `slack(prim)` (m) around its outline's box.
     pub fn new(prims: &'a [Primitive], ids: &[u32], slack: impl Fn(&Primitive) -> f64) -> Self {
-        let mut s = Surfaces {
-            prims,
-            cells: Default::default(),
-            wide: Vec::new(),
-        };
+        let mut wide = Vec::new();
+        let mut lists: GridMap<[i64; 3], Vec<usize>> = GridMap::default();
         for &id in ids {
             let Ok(k) = prims.binary_search_by_key(&id, |q| q.id) else {
                 continue;
@@ -48,28 +54,51 @@ impl<'a> Surfaces<'a> {
                 c.saturating_mul(b[i].saturating_sub(a[i]).saturating_add(1))
             });
             if !(lo.is_finite() && hi.is_finite()) || count > MAX_CELLS {
-                s.wide.push(k);
+                wide.push(k);
                 continue;
             }
             for x in a[0]..=b[0] {
                 for y in a[1]..=b[1] {
                     for z in a[2]..=b[2] {
-                        s.cells.entry([x, y, z]).or_default().push(k);
+                        lists.entry([x, y, z]).or_default().push(k);
                     }
                 }
             }
         }
-        s
+        // One flat list, each cell's polygons in filing order.
+        let mut items = Vec::new();
+        let mut cells = GridMap::default();
+        cells.reserve(lists.len());
+        for (key, list) in lists {
+            let from = items.len() as u32;
+            items.extend_from_slice(&list);
+            cells.insert(key, (from, items.len() as u32));
+        }
+        Surfaces {
+            prims,
+            cells,
+            items,
+            wide,
+            last: Cell::new(None),
+        }
     }
 
     /// Positions (in `prims`) of the polygons filed where `w` lies: every
     /// polygon whose grown box holds `w` is among them.
     pub fn near(&self, w: DVec3) -> impl Iterator<Item = usize> + '_ {
-        let cell = self
-            .cells
-            .get(&cell_of(w))
-            .map_or(&[][..], |v| v.as_slice());
-        self.wide.iter().chain(cell).copied()
+        let key = cell_of(w);
+        let (from, to) = match self.last.get() {
+            Some((k, range)) if k == key => range,
+            _ => {
+                let range = self.cells.get(&key).copied().unwrap_or((0, 0));
+                self.last.set(Some((key, range)));
+                range
+            }
+        };
+        self.wide
+            .iter()
+            .chain(&self.items[from as usize..to as usize])
+            .copied()
     }
 }
 
