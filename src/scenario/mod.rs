@@ -65,7 +65,7 @@ pub struct Alignment {
     /// scan's correction.
     pub constrained: usize,
     /// Whether this scan's fit changed the correction (fewer than 100
-    /// pairs, a step beyond `alignReach`, or one that moves no point within
+    /// pairs of its 2048 sampled points, a step beyond `alignReach`, or one that moves no point within
     /// 50 m of the sensor by more than 3 cm, change nothing).
     pub applied: bool,
     /// How far this scan's fit moved the sensor (m).
