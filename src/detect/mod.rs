@@ -324,8 +324,20 @@ impl<'p> Detector<'p> {
                 // No connected patch of this plane is large enough to be a
                 // primitive: its inliers are scattered clutter (a plane
                 // slicing through trees and cars). Take them all out of play
-                // at once rather than one fragment per round.
-                pool.remove(&inliers);
+                // at once rather than one fragment per round. By policy,
+                // the bands of other surfaces the plane crosses stay.
+                if policy.spare_crossing_surfaces {
+                    let spread = scattered_spread(&mut accepted_rms, p);
+                    let doomed = pool.off_crossing_surfaces(
+                        &inliers,
+                        plane.normal,
+                        SCATTERED_MIN_POINTS,
+                        spread,
+                    );
+                    pool.remove(&doomed);
+                } else {
+                    pool.remove(&inliers);
+                }
             } else {
                 // 3. The candidates: the largest cluster (and, by policy,
                 //    the plane's other large ones).

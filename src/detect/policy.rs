@@ -1,5 +1,5 @@
 //! Which of the cascade's rules apply: one-shot detection and the
-//! scenario's detection on each scan's leftovers differ in nine of them.
+//! scenario's detection on each scan's leftovers differ in ten of them.
 
 /// The rule set of one detection cascade. The parameters ([`Params`])
 /// say how much (distances, areas, budgets); the policy says which rules
@@ -64,6 +64,20 @@ pub struct CascadePolicy {
     /// behind them then never get a round. Only after a stall: before it,
     /// voxels where two surfaces meet are not planar either.
     pub clear_scattered_on_stall: bool,
+    /// When no connected patch of a round's plane has `minInliers` points,
+    /// the plane's inliers leave play as clutter, except those on another
+    /// surface the plane crosses: points of a sampling voxel whose live
+    /// points (at least 8) lie on a plane of their own, as flat as a
+    /// kept surface (the spread of [`clear_scattered_on_stall`]), more
+    /// than 30 degrees off the round's. A LiDAR's rings cross a street's
+    /// facades at the same heights from every pose along it, so a
+    /// horizontal plane at such a height holds a band of every facade,
+    /// too fragmented to be a patch: without this rule the band leaves
+    /// play, and sparse facades and car sides lose a band with every
+    /// such round.
+    ///
+    /// [`clear_scattered_on_stall`]: CascadePolicy::clear_scattered_on_stall
+    pub spare_crossing_surfaces: bool,
 }
 
 impl CascadePolicy {
@@ -84,6 +98,7 @@ impl CascadePolicy {
             merge_pieces: true,
             split_rough_layers: true,
             clear_scattered_on_stall: true,
+            spare_crossing_surfaces: true,
         }
     }
 
@@ -111,8 +126,10 @@ impl CascadePolicy {
     /// voxel grid, and three points of one ring fix a line, not a plane.
     /// Judging every cluster there measured less precise and less
     /// accurate, the growing ground tolerance neutral, and clearing
-    /// scattered voxels at a stall finding fewer surfaces, less precisely
-    /// (BENCHMARKS.md). Ground is judged from the scan's pose.
+    /// scattered voxels at a stall finding fewer surfaces, less precisely,
+    /// and sparing crossing surfaces mixed (crossing recall down, more
+    /// polygons with drifting poses; BENCHMARKS.md). Ground is judged from
+    /// the scan's pose.
     pub const fn scenario_leftovers() -> Self {
         CascadePolicy {
             skip_edge_on_hypotheses: false,
@@ -126,6 +143,7 @@ impl CascadePolicy {
             merge_pieces: false,
             split_rough_layers: false,
             clear_scattered_on_stall: false,
+            spare_crossing_surfaces: false,
         }
     }
 }

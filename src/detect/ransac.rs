@@ -60,6 +60,11 @@ use crate::params::Params;
 use crate::rng::Rng;
 use glam::{DVec3, Vec3};
 
+/// A voxel whose own plane lies more than this many degrees off a round's
+/// plane holds a surface crossing it (see
+/// [`PlanePool::off_crossing_surfaces`]).
+pub(crate) const CROSSING_ANGLE: f64 = 30.0;
+
 /// A plane in the cloud's local coordinates with the threshold it was
 /// counted with.
 #[derive(Clone, Copy, Debug)]
@@ -399,11 +404,7 @@ impl PlanePool {
             if (self.cell_live[c] as usize) < min_points.max(4) {
                 continue;
             }
-            let mut m = Moments::new(self.cell_box[c].0);
-            for pos in self.voxels.range(c).filter(|&pos| self.alive[pos]) {
-                m.push(self.cell_pts[pos].as_dvec3());
-            }
-            let flat = smallest_eigen3(m.covariance()).is_none_or(|(l, _)| l[0] <= max_var);
+            let flat = self.voxel_plane(c).is_none_or(|(var, _)| var <= max_var);
             if !flat {
                 out.extend(
                     self.voxels
@@ -415,6 +416,57 @@ impl PlanePool {
         }
         self.remove(&out);
         before - self.live
+    }
+
+    /// The plane through the live points of voxel `c`: the variance of
+    /// their distances from it (the smallest eigenvalue of their
+    /// covariance) and its unit normal; `None` when no single plane is
+    /// defined (see [`smallest_eigen3`]).
+    fn voxel_plane(&self, c: usize) -> Option<(f64, DVec3)> {
+        let mut m = Moments::new(self.cell_box[c].0);
+        for pos in self.voxels.range(c).filter(|&pos| self.alive[pos]) {
+            m.push(self.cell_pts[pos].as_dvec3());
+        }
+        smallest_eigen3(m.covariance()).map(|(l, v)| (l[0], v))
+    }
+
+    /// Of `positions` (points of a plane with unit `normal`), those not on
+    /// another surface crossing it: a point is kept out of the answer when
+    /// its voxel holds at least `min_points` live points (and 4), they lie
+    /// on a plane of their own within `max_spread` (RMS, m), and that
+    /// plane is more than [`CROSSING_ANGLE`] degrees off `normal`.
+    /// Positions in voxel order (as [`PlanePool::best_plane`] gives them)
+    /// judge each voxel once.
+    pub(crate) fn off_crossing_surfaces(
+        &self,
+        positions: &[u32],
+        normal: DVec3,
+        min_points: usize,
+        max_spread: f64,
+    ) -> Vec<u32> {
+        let max_var = max_spread * max_spread;
+        let cos_max = CROSSING_ANGLE.to_radians().cos();
+        let mut last: Option<(u32, bool)> = None;
+        let mut out = Vec::with_capacity(positions.len());
+        for &pos in positions {
+            let c = self.cell_of[pos as usize];
+            let crossing = match last {
+                Some((lc, v)) if lc == c => v,
+                _ => {
+                    let c = c as usize;
+                    let v = self.cell_live[c] as usize >= min_points.max(4)
+                        && self.voxel_plane(c).is_some_and(|(var, n)| {
+                            var <= max_var && n.dot(normal).abs() < cos_max
+                        });
+                    last = Some((c as u32, v));
+                    v
+                }
+            };
+            if !crossing {
+                out.push(pos);
+            }
+        }
+        out
     }
 
     /// The plane with the largest consensus among the remaining points, its
@@ -880,6 +932,68 @@ mod tests {
             "with slivers: {plain} of {plain_n} on the wall"
         );
         assert!(fat_n > 1000, "{fat_n} samples drawn");
+    }
+
+    /// Of a horizontal plane's inliers, the band of a wall it crosses is
+    /// spared; clutter in its slab and a flat patch of the plane itself (a
+    /// table top) are not, nor a wall voxel with too few points to judge.
+    #[test]
+    fn only_the_bands_of_crossing_surfaces_are_spared() {
+        let mut rng = Rng::new(11);
+        let mut pts = Vec::new();
+        // A wall: x in [0, 4] m, y = 0 (5 mm noise), z in [0, 3] m, a point
+        // every 0.1 m.
+        for i in 0..40 {
+            for k in 0..30 {
+                let y = (0.005 * rng.gaussian()) as f32;
+                pts.push(Vec3::new(i as f32 * 0.1 + 0.05, y, k as f32 * 0.1 + 0.05));
+            }
+        }
+        let wall = pts.len();
+        // A table top in the plane z = 1.5: x in [6, 8], y in [0, 2].
+        for i in 0..20 {
+            for j in 0..20 {
+                pts.push(Vec3::new(6.05 + i as f32 * 0.1, 0.05 + j as f32 * 0.1, 1.5));
+            }
+        }
+        let top = pts.len();
+        // Clutter through the slab 1.4 < z < 1.6 over x in [10, 14].
+        for _ in 0..1500 {
+            let (x, y, z) = (
+                rng.range(10.0, 14.0),
+                rng.range(0.0, 4.0),
+                rng.range(1.4, 1.6),
+            );
+            pts.push(Vec3::new(x as f32, y as f32, z as f32));
+        }
+        let clutter = pts.len();
+        // Six points of a far wall (x = 20): too few in their voxel.
+        for k in 0..6 {
+            pts.push(Vec3::new(
+                20.0,
+                0.5 + 0.1 * k as f32,
+                1.45 + 0.02 * k as f32,
+            ));
+        }
+        let pool = PlanePool::new(&pts, 1.0, None, Rng::new(12));
+        let mut inliers: Vec<u32> = (0..pts.len())
+            .filter(|&i| (pts[i].z - 1.5).abs() < 0.1)
+            .map(|i| pool.cell_pos_of[i])
+            .collect();
+        inliers.sort_unstable();
+        let doomed: Vec<usize> = pool
+            .off_crossing_surfaces(&inliers, DVec3::Z, 8, 0.02)
+            .iter()
+            .map(|&v| pool.original(v) as usize)
+            .collect();
+        let count = |r: std::ops::Range<usize>| doomed.iter().filter(|&&i| r.contains(&i)).count();
+        let in_slab =
+            |r: std::ops::Range<usize>| r.filter(|&i| (pts[i].z - 1.5).abs() < 0.1).count();
+        assert!(in_slab(0..wall) >= 80);
+        assert_eq!(count(0..wall), 0, "wall points taken");
+        assert_eq!(count(wall..top), in_slab(wall..top), "table top spared");
+        assert_eq!(count(top..clutter), in_slab(top..clutter), "clutter spared");
+        assert_eq!(count(clutter..pts.len()), 6, "an unjudged voxel spared");
     }
 
     /// Points scattered through a 10 m cube hold no plane any sample could
