@@ -325,16 +325,11 @@ impl<'p> Detector<'p> {
                 // primitive: its inliers are scattered clutter (a plane
                 // slicing through trees and cars). Take them all out of play
                 // at once rather than one fragment per round. By policy,
-                // the bands of other surfaces the plane crosses stay.
+                // the bands of other surfaces the plane crosses stay, and the
+                // plane is not tried again.
                 if policy.spare_crossing_surfaces {
                     let spread = scattered_spread(&mut accepted_rms, p);
-                    let doomed = pool.off_crossing_surfaces(
-                        &inliers,
-                        plane.normal,
-                        SCATTERED_MIN_POINTS,
-                        spread,
-                    );
-                    pool.remove(&doomed);
+                    pool.set_aside(&inliers, &plane, SCATTERED_MIN_POINTS, spread);
                 } else {
                     pool.remove(&inliers);
                 }
@@ -390,6 +385,12 @@ impl<'p> Detector<'p> {
                             for &v in cluster.iter() {
                                 reprieved[v as usize] = true;
                             }
+                        }
+                        // By policy, the bands of other surfaces it crossed
+                        // stay in play, and the plane is not tried again.
+                        _ if policy.spare_crossing_surfaces && policy.spare_rejected => {
+                            let spread = scattered_spread(&mut accepted_rms, p);
+                            pool.set_aside(cluster, &plane, SCATTERED_MIN_POINTS, spread);
                         }
                         _ => pool.remove(cluster),
                     }

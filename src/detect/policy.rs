@@ -64,20 +64,30 @@ pub struct CascadePolicy {
     /// behind them then never get a round. Only after a stall: before it,
     /// voxels where two surfaces meet are not planar either.
     pub clear_scattered_on_stall: bool,
-    /// When no connected patch of a round's plane has `minInliers` points,
-    /// the plane's inliers leave play as clutter, except those on another
-    /// surface the plane crosses: points of a sampling voxel whose live
-    /// points (at least 8) lie on a plane of their own, as flat as a
-    /// kept surface (the spread of [`clear_scattered_on_stall`]), more
-    /// than 30 degrees off the round's. A LiDAR's rings cross a street's
-    /// facades at the same heights from every pose along it, so a
-    /// horizontal plane at such a height holds a band of every facade,
-    /// too fragmented to be a patch: without this rule the band leaves
-    /// play, and sparse facades and car sides lose a band with every
-    /// such round.
+    /// Points a round's plane explains nothing with (a rejected candidate,
+    /// or all its inliers when no connected patch has `minInliers` points)
+    /// leave play, except those on another surface the plane crosses:
+    /// points of a sampling voxel whose live points (at least 8) lie on a
+    /// plane of their own, as flat as a kept surface (the spread of
+    /// [`clear_scattered_on_stall`]), more than 30 degrees off the
+    /// round's. A plane that spared any is set aside: no later hypothesis
+    /// within 2 degrees and its inlier distance of it is tried. A LiDAR's
+    /// rings cross a street's facades and car sides at the same heights
+    /// from every pose along it, so a horizontal plane at such a height
+    /// holds a band of each, as lines (rejected) or fragments (too small);
+    /// without this rule each such round takes those bands out of play,
+    /// and sparse facades and car sides end up missed.
     ///
     /// [`clear_scattered_on_stall`]: CascadePolicy::clear_scattered_on_stall
     pub spare_crossing_surfaces: bool,
+    /// With [`spare_crossing_surfaces`], a rejected candidate's points are
+    /// spared the same way (otherwise only a plane's inliers without a
+    /// large enough patch are). Needs the viewpoint: the bands it keeps in
+    /// play include the laser rings at the sensor's own height, and without
+    /// a viewpoint nothing rejects a horizontal patch they form later.
+    ///
+    /// [`spare_crossing_surfaces`]: CascadePolicy::spare_crossing_surfaces
+    pub spare_rejected: bool,
 }
 
 impl CascadePolicy {
@@ -99,6 +109,7 @@ impl CascadePolicy {
             split_rough_layers: true,
             clear_scattered_on_stall: true,
             spare_crossing_surfaces: true,
+            spare_rejected: true,
         }
     }
 
@@ -110,6 +121,7 @@ impl CascadePolicy {
             range_pulled_ground: false,
             bridge_ring_gaps: false,
             reject_edge_on_candidates: false,
+            spare_rejected: false,
             ground: GroundBy::LocalFloor,
             ..self
         }
@@ -144,6 +156,7 @@ impl CascadePolicy {
             split_rough_layers: false,
             clear_scattered_on_stall: false,
             spare_crossing_surfaces: false,
+            spare_rejected: false,
         }
     }
 }

@@ -64,6 +64,9 @@ use glam::{DVec3, Vec3};
 /// plane holds a surface crossing it (see
 /// [`PlanePool::off_crossing_surfaces`]).
 pub(crate) const CROSSING_ANGLE: f64 = 30.0;
+/// A hypothesis within this many degrees of a set-aside plane, and within
+/// its inlier distance, is that plane again (see [`PlanePool::set_aside`]).
+const SET_ASIDE_ANGLE: f64 = 2.0;
 
 /// A plane in the cloud's local coordinates with the threshold it was
 /// counted with.
@@ -100,6 +103,9 @@ impl LocalPlane {
 /// one plane, collected voxel by voxel) is close together in memory; only
 /// labels go back to original indices.
 pub struct PlanePool {
+    /// Planes no hypothesis may repeat: unit normal, offset and inlier
+    /// distance (see [`PlanePool::set_aside`]).
+    set_aside: Vec<(DVec3, f64, f64)>,
     /// Per position: still in play?
     alive: Vec<bool>,
     rx: Vec<f32>,
@@ -248,6 +254,7 @@ impl PlanePool {
             }
         });
         let mut pool = PlanePool {
+            set_aside: Vec::new(),
             pool_live: 0,
             cell_pts,
             cell_pos_of,
@@ -469,6 +476,39 @@ impl PlanePool {
         out
     }
 
+    /// Take `positions` (points of `plane` that explain nothing: a
+    /// rejected candidate, or inliers without a patch large enough) out of
+    /// play, except those on another surface the plane crosses
+    /// ([`PlanePool::off_crossing_surfaces`]). When any stay, the plane is
+    /// set aside: no later hypothesis within [`SET_ASIDE_ANGLE`] of it and
+    /// its inlier distance of it is tried, so the bands it spared cannot
+    /// bring it back round after round. Returns how many left play.
+    pub(crate) fn set_aside(
+        &mut self,
+        positions: &[u32],
+        plane: &LocalPlane,
+        min_points: usize,
+        max_spread: f64,
+    ) -> usize {
+        let doomed = self.off_crossing_surfaces(positions, plane.normal, min_points, max_spread);
+        if doomed.len() < positions.len() {
+            self.set_aside
+                .push((plane.normal, plane.offset, plane.threshold));
+        }
+        let before = self.live;
+        self.remove(&doomed);
+        before - self.live
+    }
+
+    /// Is `plane` one set aside ([`PlanePool::set_aside`])?
+    fn is_set_aside(&self, plane: &LocalPlane) -> bool {
+        let cos_max = SET_ASIDE_ANGLE.to_radians().cos();
+        self.set_aside.iter().any(|&(n, d, t)| {
+            let c = n.dot(plane.normal);
+            c.abs() > cos_max && (d - c.signum() * plane.offset).abs() < t
+        })
+    }
+
     /// The plane with the largest consensus among the remaining points, its
     /// inliers (positions, in voxel order) and their coordinates, or `None`
     /// when no plane has `min_inliers`.
@@ -524,7 +564,7 @@ impl PlanePool {
                 };
                 let at = self.cell_box[cell].0;
                 let plane = plane_for(normal, offset, at);
-                if self.seen_edge_on(&plane, viewpoint, params) {
+                if self.seen_edge_on(&plane, viewpoint, params) || self.is_set_aside(&plane) {
                     continue;
                 }
                 // Cheap local test: the plane must explain a fair share of
@@ -565,6 +605,7 @@ impl PlanePool {
                     ..refit
                 };
                 if !self.seen_edge_on(&refit, viewpoint, params)
+                    && !self.is_set_aside(&refit)
                     && self.count(&same_t, 0, lo_k) >= self.count(&best, 0, lo_k)
                 {
                     plane = refit;
@@ -993,7 +1034,34 @@ mod tests {
         assert_eq!(count(0..wall), 0, "wall points taken");
         assert_eq!(count(wall..top), in_slab(wall..top), "table top spared");
         assert_eq!(count(top..clutter), in_slab(top..clutter), "clutter spared");
-        assert_eq!(count(clutter..pts.len()), 6, "an unjudged voxel spared");
+        assert_eq!(
+            count(clutter..pts.len()),
+            6,
+            "a voxel too sparse to judge is not spared"
+        );
+        // Setting the plane aside takes the others out of play and keeps
+        // the plane (and any within 2 degrees and its inlier distance) from
+        // being a hypothesis again; it sets nothing aside when nothing
+        // was spared.
+        let mut pool = pool;
+        let plane = |n: DVec3, offset: f64| LocalPlane {
+            normal: n.normalize(),
+            offset,
+            threshold: 0.1,
+            ground: false,
+        };
+        let slab = plane(DVec3::Z, -1.5);
+        let only_clutter: Vec<u32> = (top..clutter).map(|i| pool.cell_pos_of[i]).collect();
+        assert_eq!(pool.set_aside(&only_clutter, &slab, 8, 0.02), clutter - top);
+        assert!(!pool.is_set_aside(&slab));
+        let left = pool.set_aside(&inliers, &slab, 8, 0.02);
+        assert_eq!(left, in_slab(wall..top) + 6);
+        assert!(pool.is_set_aside(&slab));
+        assert!(pool.is_set_aside(&plane(DVec3::new(0.01, 0.0, 1.0), -1.45)));
+        assert!(pool.is_set_aside(&plane(-DVec3::Z, 1.55)));
+        assert!(!pool.is_set_aside(&plane(DVec3::Z, -1.7)));
+        assert!(!pool.is_set_aside(&plane(DVec3::new(0.1, 0.0, 1.0), -1.5)));
+        assert!(!pool.is_set_aside(&plane(DVec3::Y, 0.0)));
     }
 
     /// Points scattered through a 10 m cube hold no plane any sample could
