@@ -1,5 +1,5 @@
 //! Which of the cascade's rules apply: one-shot detection and the
-//! scenario's detection on each scan's leftovers differ in ten of them.
+//! scenario's detection on each scan's leftovers differ in eleven of them.
 
 /// The rule set of one detection cascade. The parameters ([`Params`])
 /// say how much (distances, areas, budgets); the policy says which rules
