@@ -670,16 +670,7 @@ fn simulated_street_scans_and_a_location_meet_quality_floors() {
         .map(|q| q.area)
         .fold(0.0, f64::max);
     assert!(road > 500.0, "largest flat road polygon {road} m^2");
-    let polys: Vec<_> = det.primitives.iter().map(|q| q.polygon()).collect();
-    let m = evaluate(
-        &polys,
-        &gt,
-        &loc.points,
-        &loc.labels,
-        loc.points.len(),
-        &opts,
-    )
-    .unwrap();
+    let m = score_location(&det, &gt, &loc);
     assert!(
         m.detection.precision >= 0.95,
         "location precision {}",
@@ -1095,7 +1086,6 @@ fn the_ground_outline_follows_far_rings_as_far_as_they_cluster() {
 /// viewpoint 0.88.
 #[test]
 fn a_world_frame_location_without_a_viewpoint_keeps_its_ground() {
-    use polyscene::eval::{evaluate, EvalOptions};
     let (drive, gt) = street_truth();
     let loc = drive.location(20, 10).unwrap();
     let cloud = Cloud::from_world_f64(&loc.points).unwrap();
@@ -1110,16 +1100,7 @@ fn a_world_frame_location_without_a_viewpoint_keeps_its_ground() {
         .map(|q| q.area)
         .sum();
     assert!(ground > 900.0, "ground {ground} m^2");
-    let polys: Vec<_> = det.primitives.iter().map(|q| q.polygon()).collect();
-    let m = evaluate(
-        &polys,
-        &gt,
-        &loc.points,
-        &loc.labels,
-        loc.points.len(),
-        &EvalOptions::default(),
-    )
-    .unwrap();
+    let m = score_location(&det, &gt, &loc);
     assert!(
         m.completeness.completeness > 0.72,
         "{}",
@@ -1139,7 +1120,6 @@ fn a_world_frame_location_without_a_viewpoint_keeps_its_ground() {
 #[test]
 fn a_plane_through_clutter_spares_the_surfaces_it_crosses() {
     use polyscene::detect::{CascadePolicy, Detector};
-    use polyscene::eval::{evaluate, EvalOptions};
     let (drive, gt) = street_truth();
     let loc = drive.location(60, 10).unwrap();
     let cloud = Cloud::from_world_f64(&loc.points).unwrap();
@@ -1147,19 +1127,7 @@ fn a_plane_through_clutter_spares_the_surfaces_it_crosses() {
         viewpoint: Some(loc.viewpoint().to_array()),
         ..Params::gpp2()
     };
-    let score = |det: &polyscene::detect::Detection| {
-        let polys: Vec<_> = det.primitives.iter().map(|q| q.polygon()).collect();
-        let opts = EvalOptions::default();
-        evaluate(
-            &polys,
-            &gt,
-            &loc.points,
-            &loc.labels,
-            loc.points.len(),
-            &opts,
-        )
-        .unwrap()
-    };
+    let score = |det| score_location(det, &gt, &loc);
     let with = detect(&cloud, &p).unwrap();
     check_invariants(&cloud, &with, &p);
     let policy = CascadePolicy {
@@ -1180,6 +1148,18 @@ fn a_plane_through_clutter_spares_the_surfaces_it_crosses() {
     assert!(a.completeness.completeness > b.completeness.completeness + 0.01);
     assert!(a.detection.precision > 0.99, "{}", a.detection.precision);
     assert_eq!(a.duplicates.count, 0);
+}
+
+/// `det`'s polygons scored against the simulated location `loc`.
+fn score_location(
+    det: &polyscene::detect::Detection,
+    gt: &[polyscene::eval::GtSurface],
+    loc: &polyscene::sim::Location,
+) -> polyscene::eval::Metrics {
+    use polyscene::eval::{evaluate, EvalOptions};
+    let polys: Vec<_> = det.primitives.iter().map(|q| q.polygon()).collect();
+    let (pts, labels) = (&loc.points, &loc.labels);
+    evaluate(&polys, gt, pts, labels, pts.len(), &EvalOptions::default()).unwrap()
 }
 
 /// The simulated street drive (seed 1) and its ground-truth surfaces.
