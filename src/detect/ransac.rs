@@ -63,7 +63,7 @@ use glam::{DVec3, Vec3};
 /// A voxel whose own plane lies more than this many degrees off a round's
 /// plane holds a surface crossing it (see
 /// [`PlanePool::off_crossing_surfaces`]).
-pub(crate) const CROSSING_ANGLE: f64 = 30.0;
+const CROSSING_ANGLE: f64 = 30.0;
 /// A hypothesis within this many degrees of a set-aside plane, and within
 /// its inlier distance, is that plane again (see [`PlanePool::set_aside`]).
 const SET_ASIDE_ANGLE: f64 = 2.0;
@@ -480,9 +480,10 @@ impl PlanePool {
     /// rejected candidate, or inliers without a patch large enough) out of
     /// play, except those on another surface the plane crosses
     /// ([`PlanePool::off_crossing_surfaces`]). When any stay, the plane is
-    /// set aside: no later hypothesis within [`SET_ASIDE_ANGLE`] of it and
-    /// its inlier distance of it is tried, so the bands it spared cannot
-    /// bring it back round after round. Returns how many left play.
+    /// set aside: no later hypothesis (nor a refit) within
+    /// [`SET_ASIDE_ANGLE`] degrees of it and within its inlier distance is
+    /// tried, so the bands it spared cannot bring it back round after
+    /// round. Returns how many left play.
     pub(crate) fn set_aside(
         &mut self,
         positions: &[u32],
