@@ -8,6 +8,7 @@ pub(crate) mod cluster;
 pub mod kernels;
 mod policy;
 pub mod ransac;
+pub(crate) mod riser;
 mod round;
 mod viewpoint;
 
@@ -416,6 +417,17 @@ impl<'p> Detector<'p> {
                 &mut out.labels,
                 pts,
                 origin,
+                p,
+            );
+        }
+        // 8. The risers between near-horizontal surfaces a step apart.
+        if policy.find_risers {
+            riser::add_risers(
+                &mut out.primitives,
+                &mut out.labels,
+                pts,
+                origin,
+                viewpoint,
                 p,
             );
         }

@@ -1,5 +1,5 @@
 //! Which of the cascade's rules apply: one-shot detection and the
-//! scenario's detection on each scan's leftovers differ in eleven of them.
+//! scenario's detection on each scan's leftovers differ in twelve of them.
 
 /// The rule set of one detection cascade. The parameters ([`Params`])
 /// say how much (distances, areas, budgets); the policy says which rules
@@ -88,6 +88,12 @@ pub struct CascadePolicy {
     ///
     /// [`spare_crossing_surfaces`]: CascadePolicy::spare_crossing_surfaces
     pub spare_rejected: bool,
+    /// After the merge pass, the short faces between two near-horizontal
+    /// primitives a step apart (curbs, steps) become primitives of their
+    /// own where points fill the step (see the `riser` module): such a face
+    /// is narrower than `minWidth` and the two surfaces' inlier slabs take
+    /// most of its points, so no round finds it.
+    pub find_risers: bool,
 }
 
 impl CascadePolicy {
@@ -110,6 +116,7 @@ impl CascadePolicy {
             clear_scattered_on_stall: true,
             spare_crossing_surfaces: true,
             spare_rejected: true,
+            find_risers: true,
         }
     }
 
@@ -141,7 +148,10 @@ impl CascadePolicy {
     /// scattered voxels at a stall finding fewer surfaces, less precisely,
     /// and sparing crossing surfaces mixed (crossing recall down, more
     /// polygons with drifting poses; BENCHMARKS.md). Ground is judged from
-    /// the scan's pose.
+    /// the scan's pose. Risers are not found here: the scenario finds them
+    /// after this detection, between the primitives the scan reached and
+    /// from all of the scan's points (a curb's face is mostly explained by
+    /// the road's and the sidewalk's expansion, never a leftover).
     pub const fn scenario_leftovers() -> Self {
         CascadePolicy {
             skip_edge_on_hypotheses: false,
@@ -157,6 +167,7 @@ impl CascadePolicy {
             clear_scattered_on_stall: false,
             spare_crossing_surfaces: false,
             spare_rejected: false,
+            find_risers: false,
         }
     }
 }

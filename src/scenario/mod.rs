@@ -336,9 +336,23 @@ impl Scenario {
             self.index.update(&prim);
             self.primitives.push(prim);
         }
+        // 2b. Risers (curbs, steps) between the near-horizontal primitives
+        //     this scan reached, as one-shot detection finds them.
+        near.extend_from_slice(&report.added);
+        if self.params.expansion && !empty {
+            self.add_risers(
+                cloud,
+                n,
+                &near,
+                sensor,
+                &mut labels,
+                &mut alive,
+                &mut report,
+            );
+        }
+        let p = &self.params;
         report.explained_from_pool = alive[n..].iter().filter(|&&a| !a).count();
         if !empty {
-            near.extend_from_slice(&report.added);
             let seen = Surfaces::new(&self.primitives, &near, |q| surfaces::seen_slack(q, p));
             self.pool
                 .carry(cloud, n, &alive, &selection, scan, p, &|w| seen.holds(w, p));
@@ -371,6 +385,84 @@ impl Scenario {
         report.time_ms.total = clock::now_ms() - t0;
         self.last_labels = labels;
         report
+    }
+
+    /// Step 2b of [`Scenario::add_cloud`]: the risers between the
+    /// near-horizontal primitives among `near` (ids), from this scan's
+    /// points (the first `n` of `cloud`; a curb's face lies within the
+    /// expansion gates of the road and the sidewalk, so the pool holds
+    /// little of it), which they take from the primitive they were
+    /// labelled with. Each becomes a new primitive; the merge then joins
+    /// it to the riser an earlier scan found there.
+    #[allow(clippy::too_many_arguments)]
+    fn add_risers(
+        &mut self,
+        cloud: &Cloud,
+        n: usize,
+        near: &[u32],
+        sensor: DVec3,
+        labels: &mut [u32],
+        alive: &mut [bool],
+        report: &mut ScanReport,
+    ) {
+        let (p, scan) = (&self.params, self.scans);
+        let index_of =
+            |prims: &[Primitive], id: u32| prims.binary_search_by_key(&id, |q| q.id).ok();
+        let mut bound = vec![false; self.primitives.len()];
+        for &id in near {
+            if let Some(k) = index_of(&self.primitives, id) {
+                bound[k] = true;
+            }
+        }
+        let prims = &self.primitives;
+        let slot = |l: u32| index_of(prims, l);
+        let found = crate::detect::riser::find_risers(
+            prims,
+            &bound,
+            &slot,
+            &labels[..n],
+            &cloud.points[..n],
+            cloud.origin,
+            sensor,
+            p,
+            0.0,
+        );
+        // Those large enough first, then the pieces too small to stand alone
+        // (a scan sees a few metres of a curb) that continue a riser in
+        // view or just added, and merge into it.
+        let (large, small): (Vec<_>, Vec<_>) =
+            found.into_iter().partition(|(r, _)| r.area >= p.min_area);
+        let mut ids: Vec<u32> = near.to_vec();
+        for (mut riser, points) in large.into_iter().chain(small) {
+            if riser.area < p.min_area
+                && !ids.iter().any(|&id| {
+                    index_of(&self.primitives, id)
+                        .is_some_and(|k| crate::merge::mergeable(&self.primitives[k], &riser, p))
+                })
+            {
+                continue;
+            }
+            riser.id = self.next_id;
+            self.next_id += 1;
+            riser.born_scan = scan;
+            riser.last_scan = scan;
+            for &i in &points {
+                let i = i as usize;
+                let old = std::mem::replace(&mut labels[i], riser.id);
+                match index_of(&self.primitives, old) {
+                    Some(k) => {
+                        let q = &mut self.primitives[k];
+                        q.support = q.support.saturating_sub(1);
+                    }
+                    None => report.explained_by_detection += usize::from(i < n),
+                }
+                alive[i] = false;
+            }
+            report.added.push(riser.id);
+            ids.push(riser.id);
+            self.index.update(&riser);
+            self.primitives.push(riser);
+        }
     }
 
     /// Move `scan` (world frame, seen from `sensor`) by the last scan's

@@ -1,0 +1,884 @@
+//! Risers: the short faces between two near-horizontal surfaces a step
+//! apart (a curb between a road and a sidewalk, a step, the edge of a low
+//! plateau). Such a face is too narrow for a round of the cascade: it is
+//! narrower than `minWidth`, and the inlier slabs of the two surfaces
+//! take most of its points. But the two surfaces bound it, so where their
+//! outlines meet with a step between them and points fill the step, the
+//! face is there. One-shot detection adds it as a primitive of its own
+//! ([`CascadePolicy::find_risers`](super::CascadePolicy::find_risers)).
+//!
+//! One pass, after the cascade and its merge:
+//! 1. Every ordered pair of near-horizontal primitives within 5 degrees of
+//!    each other: the upper one's outline is sampled every `cell`, and a
+//!    sample is kept where the lower one's outline lies within its
+//!    clustering tolerance (in plan) and the upper surface stands between
+//!    the lower one's inlier distance and `minWidth` above it (lower steps
+//!    are one surface; higher faces are found by the cascade itself). Runs
+//!    of kept samples are cut into straight segments.
+//! 2. One pass over the points: a point near a segment (in plan) whose
+//!    height lies strictly between the two surfaces (beyond twice their
+//!    RMS, or a quarter of the lower one's inlier distance) is evidence of
+//!    that segment's face.
+//! 3. Each segment's face is the line its evidence lies along, within the
+//!    non-ground inlier distance (a robust fit: wheels and poles next to a
+//!    curb fall away). Faces on one line that overlap or lie within
+//!    `2 * alpha` merge, across pairs of surfaces (a curb runs past several
+//!    pieces of road).
+//! 4. A face is cut where its points leave a gap wider than `2 * alpha`;
+//!    a piece is kept when its points fill at least `minOccupancy` of its
+//!    length (in `cell` bins) and its area (length times step) is at least
+//!    `minArea`. Its outline is the rectangle between the two surfaces; its
+//!    points are labelled with it.
+
+use crate::geometry::plane::Moments;
+use crate::geometry::polygon::{make_ccw, segment_distance_sq, signed_area};
+use crate::geometry::{floor_i64, Footprint, Frame, Plane};
+use crate::hash::{key2, GridMap};
+use crate::params::Params;
+use crate::primitive::{Primitive, NO_PRIMITIVE};
+use glam::{DVec2, DVec3, Vec3};
+
+/// Largest angle (degrees) between the two surfaces of a step.
+const PARALLEL_DEG: f64 = 5.0;
+/// Largest tilt (degrees) from the vertical of a surface's normal for it to
+/// bound a riser: near-horizontal surfaces only.
+const MAX_TILT_DEG: f64 = 15.0;
+/// Evidence lies beyond this many times the surfaces' RMS from both...
+const MARGIN_RMS: f64 = 2.0;
+/// ...and beyond this share of the lower surface's inlier distance.
+const MARGIN_FLOOR: f64 = 0.25;
+
+/// A near-horizontal primitive, seen from above.
+struct Surface {
+    /// Its plane, normal up.
+    plane: Plane,
+    /// Outline vertices in plan (world x, y).
+    plan: Vec<DVec2>,
+    /// Outline vertices in the world.
+    ring: Vec<DVec3>,
+    lo: DVec2,
+    hi: DVec2,
+    rms: f64,
+    ground: bool,
+    /// Its points within this distance of it are the surface itself, never
+    /// a face's evidence (no segment's margin is smaller).
+    noise: f64,
+    /// Its outline's edges by plan cell (side `cell`): each edge listed in
+    /// every cell within `reach` of it.
+    edges: GridMap<u64, Vec<u32>>,
+    cell: f64,
+}
+
+impl Surface {
+    /// Whether the plan point `q` lies within `within` (at most the `reach`
+    /// its edges were listed with) of the outline.
+    fn near_outline(&self, q: DVec2, within: f64) -> bool {
+        let key = key2(floor_i64(q.x / self.cell), floor_i64(q.y / self.cell));
+        let n = self.plan.len();
+        self.edges.get(&key).is_some_and(|list| {
+            list.iter().any(|&e| {
+                let e = e as usize;
+                segment_distance_sq(q, self.plan[e], self.plan[(e + 1) % n]) <= within * within
+            })
+        })
+    }
+}
+
+/// The side of a plan grid's cells for lookups within `reach` over an
+/// area of `size`: a few times the reach (fewer entries, few items each),
+/// and at least 1/64 of the size, so that the cells an item is listed in
+/// stay few whatever the reach.
+fn grid_cell(reach: f64, size: DVec2) -> f64 {
+    (4.0 * reach).max(size.max_element() / 64.0)
+}
+
+/// The edges of a plan ring listed by cells of side `cell`, each in every
+/// cell within `reach` of it.
+fn edge_grid(plan: &[DVec2], reach: f64, cell: f64) -> GridMap<u64, Vec<u32>> {
+    let mut grid: GridMap<u64, Vec<u32>> = GridMap::default();
+    let n = plan.len();
+    for e in 0..n {
+        let (a, b) = (plan[e], plan[(e + 1) % n]);
+        let lo = a.min(b) - DVec2::splat(reach);
+        let hi = a.max(b) + DVec2::splat(reach);
+        for x in floor_i64(lo.x / cell)..=floor_i64(hi.x / cell) {
+            for y in floor_i64(lo.y / cell)..=floor_i64(hi.y / cell) {
+                grid.entry(key2(x, y)).or_default().push(e as u32);
+            }
+        }
+    }
+    grid
+}
+
+/// A straight piece of the line where an upper surface's outline meets a
+/// lower one's, and the points of the face between them.
+struct Segment {
+    lower: usize,
+    upper: usize,
+    a: DVec2,
+    b: DVec2,
+    margin: f64,
+    reach: f64,
+    face: Vec<u32>,
+}
+
+/// A riser before its final checks: its surfaces, its line and its points.
+struct Face {
+    lower: Plane,
+    upper: Plane,
+    /// A point on the line and its unit direction (plan).
+    at: DVec2,
+    dir: DVec2,
+    /// The extent of its points along the line, from `at`.
+    lo: f64,
+    hi: f64,
+    points: Vec<u32>,
+}
+
+impl Face {
+    /// A face on the line through `at` along `dir`, of the points within
+    /// `tol` of it.
+    fn new(
+        lower: Plane,
+        upper: Plane,
+        at: DVec2,
+        dir: DVec2,
+        mut points: Vec<u32>,
+        plan: impl Fn(u32) -> DVec2,
+        tol: f64,
+    ) -> Face {
+        let n = dir.perp();
+        points.retain(|&i| n.dot(plan(i) - at).abs() <= tol);
+        let (lo, hi) = points
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &i| {
+                let s = dir.dot(plan(i) - at);
+                (a.min(s), b.max(s))
+            });
+        Face {
+            lower,
+            upper,
+            at,
+            dir,
+            lo,
+            hi,
+            points,
+        }
+    }
+}
+
+/// Add the risers between the near-horizontal `primitives` (numbered from
+/// `primitives.len()` on, up to `maxPrimitives`): one-shot detection,
+/// where a label is a primitive's index. Their points are labelled with
+/// them and leave the support count of the surface they were labelled
+/// with. That surface's moments stay: they are the statistics of its
+/// robust refit (which trims most points this far off its plane), not a
+/// sum over its labels.
+pub(crate) fn add_risers(
+    primitives: &mut Vec<Primitive>,
+    labels: &mut [u32],
+    pts: &[Vec3],
+    origin: DVec3,
+    viewpoint: DVec3,
+    p: &Params,
+) {
+    let n = primitives.len();
+    let every = vec![true; n];
+    let slot = |l: u32| ((l as usize) < n).then_some(l as usize);
+    let found = find_risers(
+        primitives, &every, &slot, labels, pts, origin, viewpoint, p, p.min_area,
+    );
+    for (r, points) in found {
+        if primitives.len() >= p.max_primitives {
+            return;
+        }
+        let id = primitives.len() as u32;
+        // The points move from the surface they supported, if any.
+        for &i in &points {
+            let old = std::mem::replace(&mut labels[i as usize], id);
+            if let Some(q) = primitives.get_mut(old as usize) {
+                q.support -= 1;
+            }
+        }
+        primitives.push(Primitive { id, ..r });
+    }
+}
+
+/// The risers between the near-horizontal primitives marked in `bound`,
+/// in the order found, each with its points (indices into `pts`, local
+/// to `origin`). `labels` give each point's primitive, or
+/// [`NO_PRIMITIVE`]; `slot` turns a label into an index of `primitives`
+/// (`None`: a primitive not among them, whose points are no evidence).
+/// Points of a riser can hold a label of another one found here (the
+/// caller labels them in order, the last riser keeping them). Risers
+/// smaller than `min_area` are left out.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn find_risers(
+    primitives: &[Primitive],
+    bound: &[bool],
+    slot: &dyn Fn(u32) -> Option<usize>,
+    labels: &[u32],
+    pts: &[Vec3],
+    origin: DVec3,
+    viewpoint: DVec3,
+    p: &Params,
+    min_area: f64,
+) -> Vec<(Primitive, Vec<u32>)> {
+    let surfaces = surfaces(primitives, bound, p);
+    if surfaces.iter().flatten().count() < 2 {
+        return Vec::new();
+    }
+    let mut segments = segments(&surfaces, p);
+    if segments.is_empty() {
+        return Vec::new();
+    }
+    gather_evidence(&mut segments, &surfaces, slot, labels, pts, origin);
+    let tol = p.other.distance;
+    let mut faces: Vec<Face> = segments
+        .iter()
+        .filter_map(|s| fit_face(s, &surfaces, pts, origin, tol))
+        .collect();
+    merge_faces(&mut faces, pts, origin, tol, 2.0 * p.other.alpha);
+    let mut out = Vec::new();
+    for face in &faces {
+        for piece in split(face, pts, origin, 2.0 * p.other.alpha) {
+            out.extend(riser(face, &piece, pts, origin, viewpoint, p, min_area));
+        }
+    }
+    out
+}
+
+/// The near-horizontal primitives marked in `bound` (normal turned up),
+/// by index.
+fn surfaces(primitives: &[Primitive], bound: &[bool], p: &Params) -> Vec<Option<Surface>> {
+    let cos_tilt = libm::cos(MAX_TILT_DEG.to_radians());
+    primitives
+        .iter()
+        .zip(bound)
+        .map(|(q, &b)| {
+            let mut plane = q.plane;
+            if !b || plane.normal.z.abs() < cos_tilt {
+                return None;
+            }
+            if plane.normal.z < 0.0 {
+                plane = Plane {
+                    normal: -plane.normal,
+                    offset: -plane.offset,
+                };
+            }
+            let ring = q.vertices();
+            let reach = p.ground.cluster_tolerance.max(p.other.cluster_tolerance);
+            let plan: Vec<DVec2> = ring.iter().map(|v| v.truncate()).collect();
+            let lo = plan
+                .iter()
+                .fold(DVec2::splat(f64::INFINITY), |a, &v| a.min(v));
+            let hi = plan
+                .iter()
+                .fold(DVec2::splat(f64::NEG_INFINITY), |a, &v| a.max(v));
+            (plan.len() >= 3).then_some(Surface {
+                plane,
+                ring,
+                lo,
+                hi,
+                rms: q.rms(),
+                ground: q.ground,
+                noise: MARGIN_FLOOR * p.ground.distance.min(p.other.distance),
+                edges: edge_grid(&plan, reach, grid_cell(reach, hi - lo)),
+                cell: grid_cell(reach, hi - lo),
+                plan,
+            })
+        })
+        .collect()
+}
+
+/// Step 1: the straight pieces of the lines where an upper outline meets a
+/// lower one a step below.
+fn segments(surfaces: &[Option<Surface>], p: &Params) -> Vec<Segment> {
+    let cos_parallel = libm::cos(PARALLEL_DEG.to_radians());
+    let mut out = Vec::new();
+    for (ui, u) in surfaces.iter().enumerate() {
+        let Some(u) = u else { continue };
+        for (li, l) in surfaces.iter().enumerate() {
+            let Some(l) = l else { continue };
+            if ui == li || u.plane.normal.dot(l.plane.normal) < cos_parallel {
+                continue;
+            }
+            let (su, sl) = (p.surface(u.ground), p.surface(l.ground));
+            let reach = su.cluster_tolerance.max(sl.cluster_tolerance);
+            if u.lo.x > l.hi.x + reach
+                || l.lo.x > u.hi.x + reach
+                || u.lo.y > l.hi.y + reach
+                || l.lo.y > u.hi.y + reach
+            {
+                continue;
+            }
+            let (lowest, highest) = (sl.distance, p.min_width);
+            let margin = (MARGIN_RMS * u.rms.max(l.rms)).max(MARGIN_FLOOR * sl.distance);
+            // Samples along the upper outline, each kept or not.
+            let mut samples: Vec<(DVec2, bool)> = Vec::new();
+            let n = u.ring.len();
+            for k in 0..n {
+                let (a, b) = (u.ring[k], u.ring[(k + 1) % n]);
+                // Rounded, not ceiled: outline edges run along the footprint's
+                // cells, so their lengths are often whole cells, where a
+                // ceiling would turn on rounding error.
+                let steps = ((b - a).length() / su.cell).round().max(1.0) as usize;
+                for j in 0..steps {
+                    let q = a.lerp(b, j as f64 / steps as f64);
+                    let step = l.plane.signed_distance(q);
+                    let plan = q.truncate();
+                    let kept = step >= lowest
+                        && step <= highest
+                        && plan.x >= l.lo.x - reach
+                        && plan.x <= l.hi.x + reach
+                        && plan.y >= l.lo.y - reach
+                        && plan.y <= l.hi.y + reach
+                        && l.near_outline(plan, reach);
+                    samples.push((plan, kept));
+                }
+            }
+            for run in runs(&samples) {
+                for (a, b) in straight_pieces(&run, p.other.distance) {
+                    out.push(Segment {
+                        lower: li,
+                        upper: ui,
+                        a,
+                        b,
+                        margin,
+                        reach,
+                        face: Vec::new(),
+                    });
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The runs of consecutive kept samples of a closed ring of samples.
+fn runs(samples: &[(DVec2, bool)]) -> Vec<Vec<DVec2>> {
+    let n = samples.len();
+    let Some(start) = samples.iter().position(|s| !s.1) else {
+        // All kept: one run around the ring.
+        let mut all: Vec<DVec2> = samples.iter().map(|s| s.0).collect();
+        if let Some(&first) = all.first() {
+            all.push(first);
+        }
+        return vec![all];
+    };
+    let mut out = Vec::new();
+    let mut run: Vec<DVec2> = Vec::new();
+    for k in 1..=n {
+        let (q, kept) = samples[(start + k) % n];
+        if kept {
+            run.push(q);
+        } else if !run.is_empty() {
+            out.push(std::mem::take(&mut run));
+        }
+    }
+    out.retain(|r| r.len() >= 2);
+    out
+}
+
+/// A polyline cut into straight pieces (Douglas-Peucker within `tol`).
+fn straight_pieces(run: &[DVec2], tol: f64) -> Vec<(DVec2, DVec2)> {
+    if run.len() < 2 {
+        return Vec::new();
+    }
+    let mut keep = vec![false; run.len()];
+    keep[0] = true;
+    keep[run.len() - 1] = true;
+    let mut stack = vec![(0usize, run.len() - 1)];
+    while let Some((i, j)) = stack.pop() {
+        // Samples along cell edges often lie equally far from a chord:
+        // the first of them wins unless another is farther by a
+        // micrometre, so that rounding error (a map far from its origin)
+        // picks the same one.
+        let (mut worst, mut at) = (tol, None);
+        for k in i + 1..j {
+            let d = segment_distance_sq(run[k], run[i], run[j]).sqrt();
+            if d > worst + 1e-6 {
+                (worst, at) = (d, Some(k));
+            }
+        }
+        if let Some(k) = at {
+            keep[k] = true;
+            stack.push((i, k));
+            stack.push((k, j));
+        }
+    }
+    let corners: Vec<DVec2> = run
+        .iter()
+        .zip(&keep)
+        .filter_map(|(&q, &k)| k.then_some(q))
+        .collect();
+    corners
+        .windows(2)
+        .filter(|w| w[0] != w[1])
+        .map(|w| (w[0], w[1]))
+        .collect()
+}
+
+/// Step 2: each point near a segment, strictly between its two surfaces,
+/// joins the segment's face. Points of non-horizontal primitives are not
+/// evidence.
+fn gather_evidence(
+    segments: &mut [Segment],
+    surfaces: &[Option<Surface>],
+    slot: &dyn Fn(u32) -> Option<usize>,
+    labels: &[u32],
+    pts: &[Vec3],
+    origin: DVec3,
+) {
+    let reach = segments.iter().map(|s| s.reach).fold(0.0, f64::max);
+    let longest = segments
+        .iter()
+        .map(|s| (s.b - s.a).abs())
+        .fold(DVec2::ZERO, DVec2::max);
+    let cell = grid_cell(reach, longest);
+    if cell.is_nan() || cell <= 0.0 {
+        return;
+    }
+    let key = |q: DVec2| key2(floor_i64(q.x / cell), floor_i64(q.y / cell));
+    let mut grid: GridMap<u64, Vec<u32>> = GridMap::default();
+    for (k, s) in segments.iter().enumerate() {
+        let lo = s.a.min(s.b) - DVec2::splat(s.reach);
+        let hi = s.a.max(s.b) + DVec2::splat(s.reach);
+        for x in floor_i64(lo.x / cell)..=floor_i64(hi.x / cell) {
+            for y in floor_i64(lo.y / cell)..=floor_i64(hi.y / cell) {
+                grid.entry(key2(x, y)).or_default().push(k as u32);
+            }
+        }
+    }
+    // The heights evidence can have: between the lowest lower surface and
+    // the highest upper one near any segment (planes tilt by up to
+    // MAX_TILT_DEG over a segment's reach).
+    let slope = libm::tan(MAX_TILT_DEG.to_radians());
+    let (mut zlo, mut zhi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for s in segments.iter() {
+        let (Some(lo), Some(up)) = (&surfaces[s.lower], &surfaces[s.upper]) else {
+            continue;
+        };
+        for q in [s.a, s.b] {
+            zlo = zlo.min(height(&lo.plane, q) - s.reach * slope);
+            zhi = zhi.max(height(&up.plane, q) + s.reach * slope);
+        }
+    }
+    for (i, (pt, &l)) in pts.iter().zip(labels).enumerate() {
+        let w = origin + pt.as_dvec3();
+        if !(w.z > zlo && w.z < zhi) {
+            continue;
+        }
+        if l != NO_PRIMITIVE {
+            // Points of a non-horizontal primitive, and those within noise
+            // of the near-horizontal one they support, are no evidence.
+            match slot(l).and_then(|k| surfaces[k].as_ref()) {
+                Some(s) if s.plane.signed_distance(w).abs() > s.noise => {}
+                _ => continue,
+            }
+        }
+        let Some(list) = grid.get(&key(w.truncate())) else {
+            continue;
+        };
+        for &k in list {
+            let s = &segments[k as usize];
+            if segment_distance_sq(w.truncate(), s.a, s.b) > s.reach * s.reach {
+                continue;
+            }
+            let (Some(lo), Some(up)) = (&surfaces[s.lower], &surfaces[s.upper]) else {
+                continue;
+            };
+            if lo.plane.signed_distance(w) > s.margin && up.plane.signed_distance(w) < -s.margin {
+                segments[k as usize].face.push(i as u32);
+            }
+        }
+    }
+}
+
+/// Step 3: the line a segment's evidence lies along (within `tol`).
+fn fit_face(
+    s: &Segment,
+    surfaces: &[Option<Surface>],
+    pts: &[Vec3],
+    origin: DVec3,
+    tol: f64,
+) -> Option<Face> {
+    let (lower, upper) = (surfaces[s.lower].as_ref()?, surfaces[s.upper].as_ref()?);
+    let plan = |i: u32| (origin + pts[i as usize].as_dvec3()).truncate();
+    let mut dir = (s.b - s.a).try_normalize()?;
+    let normal = dir.perp();
+    // The offset of the face from the outline's line: the median.
+    let mut across: Vec<f64> = s.face.iter().map(|&i| normal.dot(plan(i) - s.a)).collect();
+    if across.len() < 3 {
+        return None;
+    }
+    across.sort_by(f64::total_cmp);
+    let mut at = s.a + normal * across[across.len() / 2];
+    let mut points: Vec<u32> = Vec::new();
+    for _ in 0..2 {
+        let n = dir.perp();
+        points = s
+            .face
+            .iter()
+            .copied()
+            .filter(|&i| n.dot(plan(i) - at).abs() <= tol)
+            .collect();
+        (at, dir) = line_fit(points.iter().map(|&i| plan(i)), dir)?;
+    }
+    let face = Face::new(lower.plane, upper.plane, at, dir, points, plan, tol);
+    (face.points.len() >= 3).then_some(face)
+}
+
+/// Least-squares line through plan points: its centroid and direction
+/// (turned to agree with `hint`).
+fn line_fit(points: impl Iterator<Item = DVec2>, hint: DVec2) -> Option<(DVec2, DVec2)> {
+    let q: Vec<DVec2> = points.collect();
+    if q.len() < 2 {
+        return None;
+    }
+    let c = q.iter().copied().sum::<DVec2>() / q.len() as f64;
+    let (mut xx, mut xy, mut yy) = (0.0, 0.0, 0.0);
+    for v in &q {
+        let d = *v - c;
+        xx += d.x * d.x;
+        xy += d.x * d.y;
+        yy += d.y * d.y;
+    }
+    let theta = 0.5 * libm::atan2(2.0 * xy, xx - yy);
+    let dir = DVec2::new(libm::cos(theta), libm::sin(theta));
+    Some((c, if dir.dot(hint) < 0.0 { -dir } else { dir }))
+}
+
+/// Step 3, across segments: faces on one line (within 5 degrees and `tol`)
+/// between the same heights (each surface within `tol` of the other's at
+/// the joined face's centre) whose extents overlap or lie within `gap`
+/// become one.
+fn merge_faces(faces: &mut Vec<Face>, pts: &[Vec3], origin: DVec3, tol: f64, gap: f64) {
+    let cos_parallel = libm::cos(PARALLEL_DEG.to_radians());
+    let plan = |i: u32| (origin + pts[i as usize].as_dvec3()).truncate();
+    // Groups of faces joined pairwise (union-find, smallest index as root),
+    // each fitted once.
+    let mut root: Vec<usize> = (0..faces.len()).collect();
+    fn find(root: &mut [usize], mut i: usize) -> usize {
+        while root[i] != i {
+            root[i] = root[root[i]];
+            i = root[i];
+        }
+        i
+    }
+    for i in 0..faces.len() {
+        for j in i + 1..faces.len() {
+            if on_one_line(&faces[i], &faces[j], tol, gap, cos_parallel) {
+                let (a, b) = (find(&mut root, i), find(&mut root, j));
+                root[a.max(b)] = a.min(b);
+            }
+        }
+    }
+    let mut members: Vec<Vec<usize>> = vec![Vec::new(); faces.len()];
+    for i in 0..faces.len() {
+        let r = find(&mut root, i);
+        members[r].push(i);
+    }
+    let mut next = Vec::new();
+    for (r, group) in members.iter().enumerate() {
+        match group.len() {
+            0 => {}
+            1 => {
+                let f = &mut faces[r];
+                let points = std::mem::take(&mut f.points);
+                next.push(Face { points, ..*f });
+            }
+            _ => {
+                let mut points: Vec<u32> = group
+                    .iter()
+                    .flat_map(|&k| faces[k].points.iter().copied())
+                    .collect();
+                points.sort_unstable();
+                points.dedup();
+                let f = &faces[r];
+                if let Some((at, dir)) = line_fit(points.iter().map(|&k| plan(k)), f.dir) {
+                    next.push(Face::new(f.lower, f.upper, at, dir, points, plan, tol));
+                }
+            }
+        }
+    }
+    *faces = next;
+}
+
+/// Whether two faces lie on one line (within 5 degrees and `tol`) between
+/// the same heights (each surface within `tol` of the other's at their
+/// middle), with extents that overlap or lie within `gap`.
+fn on_one_line(f: &Face, g: &Face, tol: f64, gap: f64, cos_parallel: f64) -> bool {
+    if f.dir.dot(g.dir).abs() < cos_parallel
+        || f.dir.perp().dot(g.at - f.at).abs() > tol
+        || g.dir.perp().dot(f.at - g.at).abs() > tol
+    {
+        return false;
+    }
+    let mid = (f.at + g.at) * 0.5;
+    if (height(&f.lower, mid) - height(&g.lower, mid)).abs() > tol
+        || (height(&f.upper, mid) - height(&g.upper, mid)).abs() > tol
+    {
+        return false;
+    }
+    // g's extent along f's line.
+    let ends = [g.at + g.dir * g.lo, g.at + g.dir * g.hi].map(|q| f.dir.dot(q - f.at));
+    let (g0, g1) = (ends[0].min(ends[1]), ends[0].max(ends[1]));
+    g0 <= f.hi + gap && f.lo <= g1 + gap
+}
+
+/// The height of a near-horizontal plane over the plan point `q`.
+fn height(plane: &Plane, q: DVec2) -> f64 {
+    -(plane.normal.x * q.x + plane.normal.y * q.y + plane.offset) / plane.normal.z
+}
+
+/// Step 4: a face's points, cut where they leave a gap wider than `gap`
+/// along its line; each piece in order along it.
+fn split(face: &Face, pts: &[Vec3], origin: DVec3, gap: f64) -> Vec<Vec<u32>> {
+    let along = |i: u32| {
+        face.dir
+            .dot((origin + pts[i as usize].as_dvec3()).truncate() - face.at)
+    };
+    let mut order: Vec<(f64, u32)> = face.points.iter().map(|&i| (along(i), i)).collect();
+    order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    let mut out: Vec<Vec<u32>> = Vec::new();
+    let mut last = f64::NEG_INFINITY;
+    for (s, i) in order {
+        if s - last > gap || out.is_empty() {
+            out.push(Vec::new());
+        }
+        out.last_mut().expect("pushed above").push(i);
+        last = s;
+    }
+    out
+}
+
+/// Step 4: the riser primitive of a piece of a face, if it passes, and
+/// its points (those of the piece within the inlier distance of its plane).
+fn riser(
+    face: &Face,
+    piece: &[u32],
+    pts: &[Vec3],
+    origin: DVec3,
+    viewpoint: DVec3,
+    p: &Params,
+    min_area: f64,
+) -> Option<(Primitive, Vec<u32>)> {
+    let world = |i: u32| origin + pts[i as usize].as_dvec3();
+    let (at, dir) = line_fit(piece.iter().map(|&i| world(i).truncate()), face.dir)?;
+    // Upright between the two surfaces, along the line.
+    let up = (face.lower.normal + face.upper.normal).normalize_or_zero();
+    let normal = dir.extend(0.0).cross(up).normalize_or_zero();
+    if normal == DVec3::ZERO {
+        return None;
+    }
+    let centre = at.extend(height(&face.lower, at));
+    let plane = Plane::from_point_normal(centre, normal).oriented(viewpoint);
+    let tol = p.other.distance;
+    let kept: Vec<u32> = piece
+        .iter()
+        .copied()
+        .filter(|&i| plane.signed_distance(world(i)).abs() < tol)
+        .collect();
+    let along: Vec<f64> = kept
+        .iter()
+        .map(|&i| dir.dot(world(i).truncate() - at))
+        .collect();
+    let s0 = along.iter().copied().fold(f64::INFINITY, f64::min);
+    let s1 = along.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if s1.is_nan() || s1 <= s0 {
+        return None;
+    }
+    let cell = p.other.cell;
+    // The share of the `cell` bins along its extent that hold a point.
+    let mut bins: Vec<i64> = along.iter().map(|&s| floor_i64((s - s0) / cell)).collect();
+    bins.sort_unstable();
+    bins.dedup();
+    let occupancy = bins.len() as f64 / ((s1 - s0) / cell).ceil().max(1.0);
+    if occupancy < p.min_occupancy {
+        return None;
+    }
+    // The rectangle between the two surfaces over the extent of its points:
+    // each end's foot on the line, moved along `up` onto either surface.
+    let foot = |s: f64, surface: &Plane| {
+        let q = centre + dir.extend(0.0) * s;
+        q - up * (surface.signed_distance(q) / surface.normal.dot(up))
+    };
+    let corners = [
+        foot(s0, &face.lower),
+        foot(s1, &face.lower),
+        foot(s1, &face.upper),
+        foot(s0, &face.upper),
+    ];
+    let mut moments = Moments::new(centre.round());
+    for &i in &kept {
+        moments.push(world(i));
+    }
+    let frame = Frame::on_plane(&plane, moments.mean());
+    let mut outline: Vec<DVec2> = corners.iter().map(|&c| frame.to_local(c)).collect();
+    make_ccw(&mut outline);
+    let area = signed_area(&outline);
+    if area.is_nan() || area < min_area {
+        return None;
+    }
+    let mut footprint = Footprint::new(cell);
+    let local: Vec<DVec2> = kept.iter().map(|&i| frame.to_local(world(i))).collect();
+    footprint.mark_all(&local);
+    let riser = Primitive {
+        id: 0,
+        plane,
+        frame,
+        outline,
+        area,
+        support: kept.len() as u64,
+        ground: false,
+        moments,
+        footprint,
+        born_scan: 0,
+        last_scan: 0,
+    };
+    Some((riser, kept))
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::cloud::Cloud;
+    use crate::detect::{detect, CascadePolicy, Detector, NO_PRIMITIVE};
+    use crate::params::Params;
+    use glam::DVec3;
+
+    /// A road (z = 0, y < 0) and a sidewalk `step` higher (y > 0), 20 m
+    /// along x, sampled every 0.1 m, and `face` points on the step at
+    /// y = 0, evenly along x and strictly between the two heights.
+    fn curb(step: f64, face: usize) -> Vec<f32> {
+        let mut pts = Vec::new();
+        for i in 0..200 {
+            let x = i as f64 * 0.1 + 0.05;
+            for j in 0..50 {
+                pts.extend([x, -5.0 + j as f64 * 0.1 + 0.05, 0.0]);
+            }
+            for j in 0..30 {
+                pts.extend([x, j as f64 * 0.1 + 0.05, step]);
+            }
+        }
+        for k in 0..face {
+            let x = (k as f64 + 0.5) * 20.0 / face as f64;
+            let z = step * (0.3 + 0.4 * ((k % 3) as f64 / 2.0));
+            pts.extend([x, 0.0, z]);
+        }
+        pts.into_iter().map(|v| v as f32).collect()
+    }
+
+    fn run(pts: &[f32], policy: CascadePolicy) -> (Cloud, crate::detect::Detection) {
+        let cloud = Cloud::from_flat(pts, 3).unwrap();
+        let p = Params {
+            viewpoint: Some([10.0, -3.0, 1.8]),
+            ..Params::gpp2()
+        };
+        let viewpoint = DVec3::new(10.0, -3.0, 1.8);
+        let det = Detector::new(&p, policy).run(&cloud.points, cloud.origin, viewpoint);
+        (cloud, det)
+    }
+
+    #[test]
+    fn a_curb_between_road_and_sidewalk_is_a_riser() {
+        let pts = curb(0.15, 300);
+        let (cloud, det) = run(&pts, CascadePolicy::one_shot());
+        assert_eq!(det.primitives.len(), 3, "road, sidewalk and curb");
+        let r = &det.primitives[2];
+        // Upright at y = 0, facing the sensor (on the road side).
+        assert!((r.plane.normal - DVec3::new(0.0, -1.0, 0.0)).length() < 0.01);
+        let v = r.vertices();
+        let (lo, hi) = v
+            .iter()
+            .fold((DVec3::splat(1e9), DVec3::splat(-1e9)), |(a, b), &q| {
+                (a.min(q), b.max(q))
+            });
+        assert!(lo.y.abs() < 0.01 && hi.y.abs() < 0.01, "{lo} {hi}");
+        assert!(lo.z.abs() < 0.01 && (hi.z - 0.15).abs() < 0.01, "{lo} {hi}");
+        assert!(lo.x < 0.1 && hi.x > 19.9, "{lo} {hi}");
+        assert!((r.area - 3.0).abs() < 0.05, "{}", r.area);
+        // Its points are the face's, taken from the surfaces they were on.
+        let face: Vec<usize> = (0..cloud.len())
+            .filter(|&i| cloud.world(i).y == 0.0)
+            .collect();
+        assert!(face.iter().all(|&i| det.labels[i] == 2));
+        assert_eq!(r.support, 300);
+        for (k, q) in det.primitives.iter().enumerate() {
+            let n = det.labels.iter().filter(|&&l| l == k as u32).count() as u64;
+            assert_eq!(q.support, n);
+        }
+        // Without the rule, no round finds it (too narrow).
+        let off = CascadePolicy {
+            find_risers: false,
+            ..CascadePolicy::one_shot()
+        };
+        assert_eq!(run(&pts, off).1.primitives.len(), 2);
+        // And the public one-shot detection has it.
+        let p = Params {
+            viewpoint: Some([10.0, -3.0, 1.8]),
+            ..Params::gpp2()
+        };
+        assert_eq!(detect(&cloud, &p).unwrap().primitives.len(), 3);
+    }
+
+    #[test]
+    fn a_riser_needs_a_step_filled_with_points_and_lower_than_min_width() {
+        // No points on the step (a sidewalk seen only from above): nothing.
+        assert_eq!(
+            run(&curb(0.15, 0), CascadePolicy::one_shot())
+                .1
+                .primitives
+                .len(),
+            2
+        );
+        // Points on a quarter of it only: its bins are not filled enough.
+        let mut pts = curb(0.15, 0);
+        for k in 0..100 {
+            pts.extend([k as f32 * 0.05, 0.0, 0.075]);
+        }
+        let (_, det) = run(&pts, CascadePolicy::one_shot());
+        assert!(
+            det.primitives.iter().all(|q| q.plane.normal.z.abs() > 0.9),
+            "{}",
+            det.primitives.len()
+        );
+        // A sparse face (100 points, too few for a round) 0.3 m high is a
+        // riser; 0.5 m high it is a face `minWidth` (0.4 m) allows a round
+        // to find, so the rule leaves it.
+        assert_eq!(
+            run(&curb(0.3, 100), CascadePolicy::one_shot())
+                .1
+                .primitives
+                .len(),
+            3
+        );
+        assert_eq!(
+            run(&curb(0.5, 100), CascadePolicy::one_shot())
+                .1
+                .primitives
+                .len(),
+            2
+        );
+    }
+
+    #[test]
+    fn clutter_beside_a_curb_does_not_tilt_it() {
+        // A wheel 0.3 m in front of the curb, as high as the step.
+        let mut pts = curb(0.15, 300);
+        for k in 0..80 {
+            let x = 5.0 + (k % 10) as f32 * 0.06;
+            let y = -0.25 - (k / 10) as f32 * 0.02;
+            pts.extend([x, y, 0.03 + (k % 7) as f32 * 0.015]);
+        }
+        let (_, det) = run(&pts, CascadePolicy::one_shot());
+        let r = det
+            .primitives
+            .iter()
+            .find(|q| q.plane.normal.z.abs() < 0.1)
+            .expect("a riser");
+        assert!(r.plane.normal.angle_between(DVec3::NEG_Y) < 0.5f64.to_radians());
+        assert!(r.plane.offset.abs() < 0.01, "{}", r.plane.offset);
+        assert!(det.labels.iter().filter(|&&l| l != NO_PRIMITIVE).count() > 0);
+    }
+}
