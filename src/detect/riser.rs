@@ -48,6 +48,34 @@ const MARGIN_RMS: f64 = 2.0;
 /// ...and beyond this share of the lower surface's inlier distance.
 const MARGIN_FLOOR: f64 = 0.25;
 
+/// The plan box (world x, y) a riser can lie in: the points' box, grown by
+/// the reach. Outline edges outside it are not looked at (the scenario's
+/// surfaces run far beyond one scan).
+#[derive(Clone, Copy)]
+struct Window {
+    lo: DVec2,
+    hi: DVec2,
+}
+
+impl Window {
+    fn of(pts: &[Vec3], origin: DVec3, reach: f64) -> Option<Window> {
+        let first = pts.first()?;
+        let (lo, hi) = pts
+            .iter()
+            .fold((*first, *first), |(a, b), &q| (a.min(q), b.max(q)));
+        let grow = DVec2::splat(reach);
+        Some(Window {
+            lo: (origin + lo.as_dvec3()).truncate() - grow,
+            hi: (origin + hi.as_dvec3()).truncate() + grow,
+        })
+    }
+
+    /// Whether the box `lo..hi` meets this one.
+    fn meets(&self, lo: DVec2, hi: DVec2) -> bool {
+        lo.x <= self.hi.x && hi.x >= self.lo.x && lo.y <= self.hi.y && hi.y >= self.lo.y
+    }
+}
+
 /// A near-horizontal primitive, seen from above.
 struct Surface {
     /// Its plane, normal up.
@@ -92,15 +120,19 @@ fn grid_cell(reach: f64, size: DVec2) -> f64 {
     (4.0 * reach).max(size.max_element() / 64.0)
 }
 
-/// The edges of a plan ring listed by cells of side `cell`, each in every
-/// cell within `reach` of it.
-fn edge_grid(plan: &[DVec2], reach: f64, cell: f64) -> GridMap<u64, Vec<u32>> {
+/// The edges of a plan ring that reach into the window, listed by cells of
+/// side `cell`, each in every cell within `reach` of it (and in the window).
+fn edge_grid(plan: &[DVec2], reach: f64, cell: f64, window: Window) -> GridMap<u64, Vec<u32>> {
     let mut grid: GridMap<u64, Vec<u32>> = GridMap::default();
     let n = plan.len();
     for e in 0..n {
         let (a, b) = (plan[e], plan[(e + 1) % n]);
         let lo = a.min(b) - DVec2::splat(reach);
         let hi = a.max(b) + DVec2::splat(reach);
+        if !window.meets(lo, hi) {
+            continue;
+        }
+        let (lo, hi) = (lo.max(window.lo), hi.min(window.hi));
         for x in floor_i64(lo.x / cell)..=floor_i64(hi.x / cell) {
             for y in floor_i64(lo.y / cell)..=floor_i64(hi.y / cell) {
                 grid.entry(key2(x, y)).or_default().push(e as u32);
@@ -224,11 +256,15 @@ pub(crate) fn find_risers(
     p: &Params,
     min_area: f64,
 ) -> Vec<(Primitive, Vec<u32>)> {
-    let surfaces = surfaces(primitives, bound, p);
+    let reach = p.ground.cluster_tolerance.max(p.other.cluster_tolerance);
+    let Some(window) = Window::of(pts, origin, reach) else {
+        return Vec::new();
+    };
+    let surfaces = surfaces(primitives, bound, window, p);
     if surfaces.iter().flatten().count() < 2 {
         return Vec::new();
     }
-    let mut segments = segments(&surfaces, p);
+    let mut segments = segments(&surfaces, window, p);
     if segments.is_empty() {
         return Vec::new();
     }
@@ -248,9 +284,14 @@ pub(crate) fn find_risers(
     out
 }
 
-/// The near-horizontal primitives marked in `bound` (normal turned up),
-/// by index.
-fn surfaces(primitives: &[Primitive], bound: &[bool], p: &Params) -> Vec<Option<Surface>> {
+/// The near-horizontal primitives marked in `bound` (normal turned up)
+/// that reach into the window, by index.
+fn surfaces(
+    primitives: &[Primitive],
+    bound: &[bool],
+    window: Window,
+    p: &Params,
+) -> Vec<Option<Surface>> {
     let cos_tilt = libm::cos(MAX_TILT_DEG.to_radians());
     primitives
         .iter()
@@ -275,7 +316,12 @@ fn surfaces(primitives: &[Primitive], bound: &[bool], p: &Params) -> Vec<Option<
             let hi = plan
                 .iter()
                 .fold(DVec2::splat(f64::NEG_INFINITY), |a, &v| a.max(v));
-            (plan.len() >= 3).then_some(Surface {
+            if plan.len() < 3 || !window.meets(lo, hi) {
+                return None;
+            }
+            // Only the part in the window matters.
+            let (lo, hi) = (lo.max(window.lo), hi.min(window.hi));
+            Some(Surface {
                 plane,
                 ring,
                 lo,
@@ -283,7 +329,7 @@ fn surfaces(primitives: &[Primitive], bound: &[bool], p: &Params) -> Vec<Option<
                 rms: q.rms(),
                 ground: q.ground,
                 noise: MARGIN_FLOOR * p.ground.distance.min(p.other.distance),
-                edges: edge_grid(&plan, reach, grid_cell(reach, hi - lo)),
+                edges: edge_grid(&plan, reach, grid_cell(reach, hi - lo), window),
                 cell: grid_cell(reach, hi - lo),
                 plan,
             })
@@ -293,7 +339,7 @@ fn surfaces(primitives: &[Primitive], bound: &[bool], p: &Params) -> Vec<Option<
 
 /// Step 1: the straight pieces of the lines where an upper outline meets a
 /// lower one a step below.
-fn segments(surfaces: &[Option<Surface>], p: &Params) -> Vec<Segment> {
+fn segments(surfaces: &[Option<Surface>], window: Window, p: &Params) -> Vec<Segment> {
     let cos_parallel = libm::cos(PARALLEL_DEG.to_radians());
     let mut out = Vec::new();
     for (ui, u) in surfaces.iter().enumerate() {
@@ -313,12 +359,27 @@ fn segments(surfaces: &[Option<Surface>], p: &Params) -> Vec<Segment> {
                 continue;
             }
             let (lowest, highest) = (sl.distance, p.min_width);
+            // The step is linear in plan: over the box where samples can be
+            // kept it lies between its values at the corners. Most pairs
+            // (pieces of one road) never stand a step apart.
+            let (blo, bhi) = (u.lo.max(l.lo - reach), u.hi.min(l.hi + reach));
+            let steps = [blo, DVec2::new(blo.x, bhi.y), DVec2::new(bhi.x, blo.y), bhi]
+                .map(|q| l.plane.signed_distance(q.extend(height(&u.plane, q))));
+            if steps.iter().all(|&d| d < lowest) || steps.iter().all(|&d| d > highest) {
+                continue;
+            }
             let margin = (MARGIN_RMS * u.rms.max(l.rms)).max(MARGIN_FLOOR * sl.distance);
             // Samples along the upper outline, each kept or not.
             let mut samples: Vec<(DVec2, bool)> = Vec::new();
             let n = u.ring.len();
             for k in 0..n {
                 let (a, b) = (u.ring[k], u.ring[(k + 1) % n]);
+                let (pa, pb) = (a.truncate(), b.truncate());
+                if !window.meets(pa.min(pb), pa.max(pb)) {
+                    // Out of the window: one sample, not kept, ends a run.
+                    samples.push((pa, false));
+                    continue;
+                }
                 // Rounded, not ceiled: outline edges run along the footprint's
                 // cells, so their lengths are often whole cells, where a
                 // ceiling would turn on rounding error.
@@ -430,24 +491,47 @@ fn gather_evidence(
     pts: &[Vec3],
     origin: DVec3,
 ) {
+    // The segments listed by plan cell (compressed rows over their box),
+    // each in every cell within its reach: a point looks at its cell's.
     let reach = segments.iter().map(|s| s.reach).fold(0.0, f64::max);
-    let longest = segments
-        .iter()
-        .map(|s| (s.b - s.a).abs())
-        .fold(DVec2::ZERO, DVec2::max);
-    let cell = grid_cell(reach, longest);
+    let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+    for s in segments.iter() {
+        lo = lo.min(s.a.min(s.b) - DVec2::splat(s.reach));
+        hi = hi.max(s.a.max(s.b) + DVec2::splat(s.reach));
+    }
+    // Cells a few times the reach, and at most 512 a side.
+    let cell = (4.0 * reach).max((hi - lo).max_element() / 512.0);
     if cell.is_nan() || cell <= 0.0 {
         return;
     }
-    let key = |q: DVec2| key2(floor_i64(q.x / cell), floor_i64(q.y / cell));
-    let mut grid: GridMap<u64, Vec<u32>> = GridMap::default();
+    let side = |extent: f64| (extent / cell).floor() as usize + 1;
+    let (w, h) = (side(hi.x - lo.x), side(hi.y - lo.y));
+    let cell_of = |q: DVec2| -> Option<usize> {
+        let (x, y) = ((q.x - lo.x) / cell, (q.y - lo.y) / cell);
+        (x >= 0.0 && y >= 0.0 && x < w as f64 && y < h as f64).then(|| y as usize * w + x as usize)
+    };
+    let cells_of = |s: &Segment| {
+        let a = (s.a.min(s.b) - DVec2::splat(s.reach) - lo) / cell;
+        let b = (s.a.max(s.b) + DVec2::splat(s.reach) - lo) / cell;
+        let xs = (a.x.max(0.0) as usize)..=((b.x as usize).min(w - 1));
+        let ys = (a.y.max(0.0) as usize)..=((b.y as usize).min(h - 1));
+        ys.flat_map(move |y| xs.clone().map(move |x| y * w + x))
+    };
+    let mut start = vec![0u32; w * h + 1];
+    for s in segments.iter() {
+        for c in cells_of(s) {
+            start[c + 1] += 1;
+        }
+    }
+    for c in 0..w * h {
+        start[c + 1] += start[c];
+    }
+    let mut fill = start.clone();
+    let mut items = vec![0u32; start[w * h] as usize];
     for (k, s) in segments.iter().enumerate() {
-        let lo = s.a.min(s.b) - DVec2::splat(s.reach);
-        let hi = s.a.max(s.b) + DVec2::splat(s.reach);
-        for x in floor_i64(lo.x / cell)..=floor_i64(hi.x / cell) {
-            for y in floor_i64(lo.y / cell)..=floor_i64(hi.y / cell) {
-                grid.entry(key2(x, y)).or_default().push(k as u32);
-            }
+        for c in cells_of(s) {
+            items[fill[c] as usize] = k as u32;
+            fill[c] += 1;
         }
     }
     // The heights evidence can have: between the lowest lower surface and
@@ -469,6 +553,13 @@ fn gather_evidence(
         if !(w.z > zlo && w.z < zhi) {
             continue;
         }
+        let Some(c) = cell_of(w.truncate()) else {
+            continue;
+        };
+        let list = &items[start[c] as usize..start[c + 1] as usize];
+        if list.is_empty() {
+            continue;
+        }
         if l != NO_PRIMITIVE {
             // Points of a non-horizontal primitive, and those within noise
             // of the near-horizontal one they support, are no evidence.
@@ -477,9 +568,6 @@ fn gather_evidence(
                 _ => continue,
             }
         }
-        let Some(list) = grid.get(&key(w.truncate())) else {
-            continue;
-        };
         for &k in list {
             let s = &segments[k as usize];
             if segment_distance_sq(w.truncate(), s.a, s.b) > s.reach * s.reach {
