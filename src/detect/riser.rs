@@ -5,11 +5,14 @@
 //! take most of its points. But the two surfaces bound it, so where their
 //! outlines meet with a step between them and points fill the step, the
 //! face is there. One-shot detection adds it as a primitive of its own
-//! ([`CascadePolicy::find_risers`](super::CascadePolicy::find_risers)).
+//! after its merge pass
+//! ([`CascadePolicy::find_risers`](super::CascadePolicy::find_risers));
+//! the scenario after each scan's detection, from the scan's points.
 //!
-//! One pass, after the cascade and its merge:
+//! One pass over the primitives and the points:
 //! 1. Every ordered pair of near-horizontal primitives within 5 degrees of
-//!    each other: the upper one's outline is sampled every `cell`, and a
+//!    each other: the upper one's outline (its edges within reach of the
+//!    points' box) is sampled every `cell`, and a
 //!    sample is kept where the lower one's outline lies within its
 //!    clustering tolerance (in plan) and the upper surface stands between
 //!    the lower one's inlier distance and `minWidth` above it (lower steps
@@ -32,8 +35,7 @@
 
 use crate::geometry::plane::Moments;
 use crate::geometry::polygon::{make_ccw, segment_distance_sq, signed_area};
-use crate::geometry::{floor_i64, Footprint, Frame, Plane};
-use crate::hash::{key2, GridMap};
+use crate::geometry::{Footprint, Frame, Plane};
 use crate::params::Params;
 use crate::primitive::{Primitive, NO_PRIMITIVE};
 use glam::{DVec2, DVec3, Vec3};
@@ -91,20 +93,18 @@ struct Surface {
     /// Its points within this distance of it are the surface itself, never
     /// a face's evidence (no segment's margin is smaller).
     noise: f64,
-    /// Its outline's edges by plan cell (side `cell`): each edge listed in
-    /// every cell within `reach` of it.
-    edges: GridMap<u64, Vec<u32>>,
-    cell: f64,
+    /// Its outline's edges by plan cell: each edge listed in every cell
+    /// within `reach` of it (in the window).
+    edges: Option<CellLists>,
 }
 
 impl Surface {
     /// Whether the plan point `q` lies within `within` (at most the `reach`
     /// its edges were listed with) of the outline.
     fn near_outline(&self, q: DVec2, within: f64) -> bool {
-        let key = key2(floor_i64(q.x / self.cell), floor_i64(q.y / self.cell));
         let n = self.plan.len();
-        self.edges.get(&key).is_some_and(|list| {
-            list.iter().any(|&e| {
+        self.edges.as_ref().is_some_and(|grid| {
+            grid.at(q).iter().any(|&e| {
                 let e = e as usize;
                 segment_distance_sq(q, self.plan[e], self.plan[(e + 1) % n]) <= within * within
             })
@@ -112,34 +112,102 @@ impl Surface {
     }
 }
 
-/// The side of a plan grid's cells for lookups within `reach` over an
-/// area of `size`: a few times the reach (fewer entries, few items each),
-/// and at least 1/64 of the size, so that the cells an item is listed in
-/// stay few whatever the reach.
-fn grid_cell(reach: f64, size: DVec2) -> f64 {
-    (4.0 * reach).max(size.max_element() / 64.0)
+/// Items listed by the cells of a plan grid (compressed rows): each item
+/// in every cell its box meets. Cells are squares of the side asked for,
+/// grown so that the grid has at most 512 a side.
+struct CellLists {
+    lo: DVec2,
+    cell: f64,
+    w: usize,
+    h: usize,
+    start: Vec<u32>,
+    items: Vec<u32>,
 }
 
-/// The edges of a plan ring that reach into the window, listed by cells of
-/// side `cell`, each in every cell within `reach` of it (and in the window).
-fn edge_grid(plan: &[DVec2], reach: f64, cell: f64, window: Window) -> GridMap<u64, Vec<u32>> {
-    let mut grid: GridMap<u64, Vec<u32>> = GridMap::default();
-    let n = plan.len();
-    for e in 0..n {
-        let (a, b) = (plan[e], plan[(e + 1) % n]);
-        let lo = a.min(b) - DVec2::splat(reach);
-        let hi = a.max(b) + DVec2::splat(reach);
-        if !window.meets(lo, hi) {
-            continue;
+impl CellLists {
+    /// Per item its box, or `None` (not listed). `None` when nothing is.
+    fn new(boxes: &[Option<(DVec2, DVec2)>], cell: f64) -> Option<CellLists> {
+        let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+        for &(a, b) in boxes.iter().flatten() {
+            (lo, hi) = (lo.min(a), hi.max(b));
         }
-        let (lo, hi) = (lo.max(window.lo), hi.min(window.hi));
-        for x in floor_i64(lo.x / cell)..=floor_i64(hi.x / cell) {
-            for y in floor_i64(lo.y / cell)..=floor_i64(hi.y / cell) {
-                grid.entry(key2(x, y)).or_default().push(e as u32);
+        let cell = cell.max((hi - lo).max_element() / 512.0);
+        if !(lo.x <= hi.x && lo.y <= hi.y) || cell.is_nan() || cell <= 0.0 {
+            return None;
+        }
+        let side = |extent: f64| (extent / cell) as usize + 1;
+        let (w, h) = (side(hi.x - lo.x), side(hi.y - lo.y));
+        let mut grid = CellLists {
+            lo,
+            cell,
+            w,
+            h,
+            start: vec![0; w * h + 1],
+            items: Vec::new(),
+        };
+        for &(a, b) in boxes.iter().flatten() {
+            grid.each_cell(a, b, |c, g| g.start[c + 1] += 1);
+        }
+        for c in 0..w * h {
+            grid.start[c + 1] += grid.start[c];
+        }
+        let mut fill = grid.start.clone();
+        grid.items = vec![0; grid.start[w * h] as usize];
+        for (k, &(a, b)) in boxes
+            .iter()
+            .enumerate()
+            .filter_map(|(k, b)| Some((k, b.as_ref()?)))
+        {
+            grid.each_cell(a, b, |c, g| {
+                g.items[fill[c] as usize] = k as u32;
+                fill[c] += 1;
+            });
+        }
+        Some(grid)
+    }
+
+    /// Call `f` with every cell the box `a..b` meets.
+    fn each_cell(&mut self, a: DVec2, b: DVec2, mut f: impl FnMut(usize, &mut CellLists)) {
+        let (a, b) = ((a - self.lo) / self.cell, (b - self.lo) / self.cell);
+        let (x1, y1) = (
+            (b.x as usize).min(self.w - 1),
+            (b.y as usize).min(self.h - 1),
+        );
+        for y in (a.y.max(0.0) as usize)..=y1 {
+            for x in (a.x.max(0.0) as usize)..=x1 {
+                f(y * self.w + x, self);
             }
         }
     }
-    grid
+
+    /// The items listed in the cell of `q` (none outside the grid).
+    fn at(&self, q: DVec2) -> &[u32] {
+        let (x, y) = ((q.x - self.lo.x) / self.cell, (q.y - self.lo.y) / self.cell);
+        if !(x >= 0.0 && y >= 0.0 && x < self.w as f64 && y < self.h as f64) {
+            return &[];
+        }
+        let c = y as usize * self.w + x as usize;
+        &self.items[self.start[c] as usize..self.start[c + 1] as usize]
+    }
+}
+
+/// The edges of a plan ring that reach into the window, listed by cells,
+/// each in every cell within `reach` of it.
+#[inline(never)]
+fn edge_grid(plan: &[DVec2], reach: f64, window: Window) -> Option<CellLists> {
+    let n = plan.len();
+    let boxes: Vec<Option<(DVec2, DVec2)>> = (0..n)
+        .map(|e| {
+            let (a, b) = (plan[e], plan[(e + 1) % n]);
+            let lo = a.min(b) - DVec2::splat(reach);
+            let hi = a.max(b) + DVec2::splat(reach);
+            window
+                .meets(lo, hi)
+                .then(|| (lo.max(window.lo), hi.min(window.hi)))
+        })
+        .collect();
+    // Cells a few times the reach: fewer entries, few edges each.
+    CellLists::new(&boxes, 4.0 * reach)
 }
 
 /// A straight piece of the line where an upper surface's outline meets a
@@ -245,6 +313,7 @@ pub(crate) fn add_risers(
 /// caller labels them in order, the last riser keeping them). Risers
 /// smaller than `min_area` are left out.
 #[allow(clippy::too_many_arguments)]
+#[inline(never)]
 pub(crate) fn find_risers(
     primitives: &[Primitive],
     bound: &[bool],
@@ -286,6 +355,7 @@ pub(crate) fn find_risers(
 
 /// The near-horizontal primitives marked in `bound` (normal turned up)
 /// that reach into the window, by index.
+#[inline(never)]
 fn surfaces(
     primitives: &[Primitive],
     bound: &[bool],
@@ -329,8 +399,7 @@ fn surfaces(
                 rms: q.rms(),
                 ground: q.ground,
                 noise: MARGIN_FLOOR * p.ground.distance.min(p.other.distance),
-                edges: edge_grid(&plan, reach, grid_cell(reach, hi - lo), window),
-                cell: grid_cell(reach, hi - lo),
+                edges: edge_grid(&plan, reach, window),
                 plan,
             })
         })
@@ -339,6 +408,7 @@ fn surfaces(
 
 /// Step 1: the straight pieces of the lines where an upper outline meets a
 /// lower one a step below.
+#[inline(never)]
 fn segments(surfaces: &[Option<Surface>], window: Window, p: &Params) -> Vec<Segment> {
     let cos_parallel = libm::cos(PARALLEL_DEG.to_radians());
     let mut out = Vec::new();
@@ -483,6 +553,7 @@ fn straight_pieces(run: &[DVec2], tol: f64) -> Vec<(DVec2, DVec2)> {
 /// Step 2: each point near a segment, strictly between its two surfaces,
 /// joins the segment's face. Points of non-horizontal primitives are not
 /// evidence.
+#[inline(never)]
 fn gather_evidence(
     segments: &mut [Segment],
     surfaces: &[Option<Surface>],
@@ -491,53 +562,24 @@ fn gather_evidence(
     pts: &[Vec3],
     origin: DVec3,
 ) {
-    // The segments listed by plan cell (compressed rows over their box),
-    // each in every cell within its reach: a point looks at its cell's.
+    // The segments listed by plan cell, each in every cell within its
+    // reach: a point looks at its cell's.
     let reach = segments.iter().map(|s| s.reach).fold(0.0, f64::max);
-    let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
-    for s in segments.iter() {
-        lo = lo.min(s.a.min(s.b) - DVec2::splat(s.reach));
-        hi = hi.max(s.a.max(s.b) + DVec2::splat(s.reach));
-    }
-    // Cells a few times the reach, and at most 512 a side.
-    let cell = (4.0 * reach).max((hi - lo).max_element() / 512.0);
-    if cell.is_nan() || cell <= 0.0 {
+    let boxes: Vec<Option<(DVec2, DVec2)>> = segments
+        .iter()
+        .map(|s| {
+            let r = DVec2::splat(s.reach);
+            Some((s.a.min(s.b) - r, s.a.max(s.b) + r))
+        })
+        .collect();
+    let Some(grid) = CellLists::new(&boxes, 4.0 * reach) else {
         return;
-    }
-    let side = |extent: f64| (extent / cell).floor() as usize + 1;
-    let (w, h) = (side(hi.x - lo.x), side(hi.y - lo.y));
-    let cell_of = |q: DVec2| -> Option<usize> {
-        let (x, y) = ((q.x - lo.x) / cell, (q.y - lo.y) / cell);
-        (x >= 0.0 && y >= 0.0 && x < w as f64 && y < h as f64).then(|| y as usize * w + x as usize)
     };
-    let cells_of = |s: &Segment| {
-        let a = (s.a.min(s.b) - DVec2::splat(s.reach) - lo) / cell;
-        let b = (s.a.max(s.b) + DVec2::splat(s.reach) - lo) / cell;
-        let xs = (a.x.max(0.0) as usize)..=((b.x as usize).min(w - 1));
-        let ys = (a.y.max(0.0) as usize)..=((b.y as usize).min(h - 1));
-        ys.flat_map(move |y| xs.clone().map(move |x| y * w + x))
-    };
-    let mut start = vec![0u32; w * h + 1];
-    for s in segments.iter() {
-        for c in cells_of(s) {
-            start[c + 1] += 1;
-        }
-    }
-    for c in 0..w * h {
-        start[c + 1] += start[c];
-    }
-    let mut fill = start.clone();
-    let mut items = vec![0u32; start[w * h] as usize];
-    for (k, s) in segments.iter().enumerate() {
-        for c in cells_of(s) {
-            items[fill[c] as usize] = k as u32;
-            fill[c] += 1;
-        }
-    }
     // The heights evidence can have: between the lowest lower surface and
     // the highest upper one near any segment (planes tilt by up to
     // MAX_TILT_DEG over a segment's reach).
-    let slope = libm::tan(MAX_TILT_DEG.to_radians());
+    let tilt = MAX_TILT_DEG.to_radians();
+    let slope = libm::sin(tilt) / libm::cos(tilt);
     let (mut zlo, mut zhi) = (f64::INFINITY, f64::NEG_INFINITY);
     for s in segments.iter() {
         let (Some(lo), Some(up)) = (&surfaces[s.lower], &surfaces[s.upper]) else {
@@ -553,10 +595,7 @@ fn gather_evidence(
         if !(w.z > zlo && w.z < zhi) {
             continue;
         }
-        let Some(c) = cell_of(w.truncate()) else {
-            continue;
-        };
-        let list = &items[start[c] as usize..start[c + 1] as usize];
+        let list = grid.at(w.truncate());
         if list.is_empty() {
             continue;
         }
@@ -584,6 +623,7 @@ fn gather_evidence(
 }
 
 /// Step 3: the line a segment's evidence lies along (within `tol`).
+#[inline(never)]
 fn fit_face(
     s: &Segment,
     surfaces: &[Option<Surface>],
@@ -632,8 +672,16 @@ fn line_fit(points: impl Iterator<Item = DVec2>, hint: DVec2) -> Option<(DVec2, 
         xy += d.x * d.y;
         yy += d.y * d.y;
     }
-    let theta = 0.5 * libm::atan2(2.0 * xy, xx - yy);
-    let dir = DVec2::new(libm::cos(theta), libm::sin(theta));
+    // The major axis of the scatter: the eigenvector of its larger
+    // eigenvalue (along x when the points spread equally every way).
+    let half = 0.5 * (xx - yy);
+    let big = 0.5 * (xx + yy) + (half * half + xy * xy).sqrt();
+    let v = if xx >= yy {
+        DVec2::new(big - yy, xy)
+    } else {
+        DVec2::new(xy, big - xx)
+    };
+    let dir = v.try_normalize().unwrap_or(DVec2::X);
     Some((c, if dir.dot(hint) < 0.0 { -dir } else { dir }))
 }
 
@@ -641,6 +689,7 @@ fn line_fit(points: impl Iterator<Item = DVec2>, hint: DVec2) -> Option<(DVec2, 
 /// between the same heights (each surface within `tol` of the other's at
 /// the joined face's centre) whose extents overlap or lie within `gap`
 /// become one.
+#[inline(never)]
 fn merge_faces(faces: &mut Vec<Face>, pts: &[Vec3], origin: DVec3, tol: f64, gap: f64) {
     let cos_parallel = libm::cos(PARALLEL_DEG.to_radians());
     let plan = |i: u32| (origin + pts[i as usize].as_dvec3()).truncate();
@@ -722,27 +771,35 @@ fn height(plane: &Plane, q: DVec2) -> f64 {
 
 /// Step 4: a face's points, cut where they leave a gap wider than `gap`
 /// along its line; each piece in order along it.
+#[inline(never)]
 fn split(face: &Face, pts: &[Vec3], origin: DVec3, gap: f64) -> Vec<Vec<u32>> {
-    let along = |i: u32| {
-        face.dir
-            .dot((origin + pts[i as usize].as_dvec3()).truncate() - face.at)
-    };
-    let mut order: Vec<(f64, u32)> = face.points.iter().map(|&i| (along(i), i)).collect();
-    order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-    let mut out: Vec<Vec<u32>> = Vec::new();
-    let mut last = f64::NEG_INFINITY;
-    for (s, i) in order {
-        if s - last > gap || out.is_empty() {
-            out.push(Vec::new());
-        }
-        out.last_mut().expect("pushed above").push(i);
-        last = s;
+    let along: Vec<f64> = face
+        .points
+        .iter()
+        .map(|&i| {
+            face.dir
+                .dot((origin + pts[i as usize].as_dvec3()).truncate() - face.at)
+        })
+        .collect();
+    // The cuts: the starts of the gaps wider than `gap` between the sorted
+    // positions; a point's piece is the number of cuts below it.
+    let mut sorted = along.clone();
+    sorted.sort_by(f64::total_cmp);
+    let cuts: Vec<f64> = sorted
+        .windows(2)
+        .filter(|w| w[1] - w[0] > gap)
+        .map(|w| w[0])
+        .collect();
+    let mut out: Vec<Vec<u32>> = vec![Vec::new(); cuts.len() + 1];
+    for (&i, &s) in face.points.iter().zip(&along) {
+        out[cuts.partition_point(|&c| c < s)].push(i);
     }
     out
 }
 
 /// Step 4: the riser primitive of a piece of a face, if it passes, and
 /// its points (those of the piece within the inlier distance of its plane).
+#[inline(never)]
 fn riser(
     face: &Face,
     piece: &[u32],
@@ -779,8 +836,8 @@ fn riser(
     }
     let cell = p.other.cell;
     // The share of the `cell` bins along its extent that hold a point.
-    let mut bins: Vec<i64> = along.iter().map(|&s| floor_i64((s - s0) / cell)).collect();
-    bins.sort_unstable();
+    let mut bins: Vec<f64> = along.iter().map(|&s| ((s - s0) / cell).floor()).collect();
+    bins.sort_by(f64::total_cmp);
     bins.dedup();
     let occupancy = bins.len() as f64 / ((s1 - s0) / cell).ceil().max(1.0);
     if occupancy < p.min_occupancy {
