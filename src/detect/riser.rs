@@ -578,8 +578,9 @@ fn gather_evidence(
     // The heights evidence can have: between the lowest lower surface and
     // the highest upper one near any segment (planes tilt by up to
     // MAX_TILT_DEG over a segment's reach).
-    let tilt = MAX_TILT_DEG.to_radians();
-    let slope = libm::sin(tilt) / libm::cos(tilt);
+    // tan(MAX_TILT_DEG), as a constant: libm's tangent or sine would be
+    // new code in the wasm.
+    let slope = 0.267_949_192_431_122_7;
     let (mut zlo, mut zhi) = (f64::INFINITY, f64::NEG_INFINITY);
     for s in segments.iter() {
         let (Some(lo), Some(up)) = (&surfaces[s.lower], &surfaces[s.upper]) else {
