@@ -193,7 +193,6 @@ impl CellLists {
 
 /// The edges of a plan ring that reach into the window, listed by cells,
 /// each in every cell within `reach` of it.
-#[inline(never)]
 fn edge_grid(plan: &[DVec2], reach: f64, window: Window) -> Option<CellLists> {
     let n = plan.len();
     let boxes: Vec<Option<(DVec2, DVec2)>> = (0..n)
@@ -313,7 +312,6 @@ pub(crate) fn add_risers(
 /// caller labels them in order, the last riser keeping them). Risers
 /// smaller than `min_area` are left out.
 #[allow(clippy::too_many_arguments)]
-#[inline(never)]
 pub(crate) fn find_risers(
     primitives: &[Primitive],
     bound: &[bool],
@@ -355,7 +353,6 @@ pub(crate) fn find_risers(
 
 /// The near-horizontal primitives marked in `bound` (normal turned up)
 /// that reach into the window, by index.
-#[inline(never)]
 fn surfaces(
     primitives: &[Primitive],
     bound: &[bool],
@@ -408,7 +405,6 @@ fn surfaces(
 
 /// Step 1: the straight pieces of the lines where an upper outline meets a
 /// lower one a step below.
-#[inline(never)]
 fn segments(surfaces: &[Option<Surface>], window: Window, p: &Params) -> Vec<Segment> {
     let cos_parallel = libm::cos(PARALLEL_DEG.to_radians());
     let mut out = Vec::new();
@@ -553,7 +549,6 @@ fn straight_pieces(run: &[DVec2], tol: f64) -> Vec<(DVec2, DVec2)> {
 /// Step 2: each point near a segment, strictly between its two surfaces,
 /// joins the segment's face. Points of non-horizontal primitives are not
 /// evidence.
-#[inline(never)]
 fn gather_evidence(
     segments: &mut [Segment],
     surfaces: &[Option<Surface>],
@@ -624,7 +619,6 @@ fn gather_evidence(
 }
 
 /// Step 3: the line a segment's evidence lies along (within `tol`).
-#[inline(never)]
 fn fit_face(
     s: &Segment,
     surfaces: &[Option<Surface>],
@@ -690,7 +684,6 @@ fn line_fit(points: impl Iterator<Item = DVec2>, hint: DVec2) -> Option<(DVec2, 
 /// between the same heights (each surface within `tol` of the other's at
 /// the joined face's centre) whose extents overlap or lie within `gap`
 /// become one.
-#[inline(never)]
 fn merge_faces(faces: &mut Vec<Face>, pts: &[Vec3], origin: DVec3, tol: f64, gap: f64) {
     let cos_parallel = libm::cos(PARALLEL_DEG.to_radians());
     let plan = |i: u32| (origin + pts[i as usize].as_dvec3()).truncate();
@@ -772,7 +765,6 @@ fn height(plane: &Plane, q: DVec2) -> f64 {
 
 /// Step 4: a face's points, cut where they leave a gap wider than `gap`
 /// along its line; each piece in order along it.
-#[inline(never)]
 fn split(face: &Face, pts: &[Vec3], origin: DVec3, gap: f64) -> Vec<Vec<u32>> {
     let along: Vec<f64> = face
         .points
@@ -800,7 +792,6 @@ fn split(face: &Face, pts: &[Vec3], origin: DVec3, gap: f64) -> Vec<Vec<u32>> {
 
 /// Step 4: the riser primitive of a piece of a face, if it passes, and
 /// its points (those of the piece within the inlier distance of its plane).
-#[inline(never)]
 fn riser(
     face: &Face,
     piece: &[u32],
