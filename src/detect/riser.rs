@@ -243,15 +243,15 @@ impl Face {
         at: DVec2,
         dir: DVec2,
         mut points: Vec<u32>,
-        plan: impl Fn(u32) -> DVec2,
+        plan: Plan,
         tol: f64,
     ) -> Face {
         let n = dir.perp();
-        points.retain(|&i| n.dot(plan(i) - at).abs() <= tol);
+        points.retain(|&i| n.dot(plan.at(i) - at).abs() <= tol);
         let (lo, hi) = points
             .iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &i| {
-                let s = dir.dot(plan(i) - at);
+                let s = dir.dot(plan.at(i) - at);
                 (a.min(s), b.max(s))
             });
         Face {
@@ -263,6 +263,20 @@ impl Face {
             hi,
             points,
         }
+    }
+}
+
+/// The points (local to `origin`) seen from above.
+#[derive(Clone, Copy)]
+struct Plan<'a> {
+    pts: &'a [Vec3],
+    origin: DVec3,
+}
+
+impl Plan<'_> {
+    /// Point `i` in plan (world x, y).
+    fn at(&self, i: u32) -> DVec2 {
+        (self.origin + self.pts[i as usize].as_dvec3()).truncate()
     }
 }
 
@@ -627,11 +641,15 @@ fn fit_face(
     tol: f64,
 ) -> Option<Face> {
     let (lower, upper) = (surfaces[s.lower].as_ref()?, surfaces[s.upper].as_ref()?);
-    let plan = |i: u32| (origin + pts[i as usize].as_dvec3()).truncate();
+    let plan = Plan { pts, origin };
     let mut dir = (s.b - s.a).try_normalize()?;
     let normal = dir.perp();
     // The offset of the face from the outline's line: the median.
-    let mut across: Vec<f64> = s.face.iter().map(|&i| normal.dot(plan(i) - s.a)).collect();
+    let mut across: Vec<f64> = s
+        .face
+        .iter()
+        .map(|&i| normal.dot(plan.at(i) - s.a))
+        .collect();
     if across.len() < 3 {
         return None;
     }
@@ -644,18 +662,18 @@ fn fit_face(
             .face
             .iter()
             .copied()
-            .filter(|&i| n.dot(plan(i) - at).abs() <= tol)
+            .filter(|&i| n.dot(plan.at(i) - at).abs() <= tol)
             .collect();
-        (at, dir) = line_fit(points.iter().map(|&i| plan(i)), dir)?;
+        (at, dir) = line_fit(plan, &points, dir)?;
     }
     let face = Face::new(lower.plane, upper.plane, at, dir, points, plan, tol);
     (face.points.len() >= 3).then_some(face)
 }
 
-/// Least-squares line through plan points: its centroid and direction
-/// (turned to agree with `hint`).
-fn line_fit(points: impl Iterator<Item = DVec2>, hint: DVec2) -> Option<(DVec2, DVec2)> {
-    let q: Vec<DVec2> = points.collect();
+/// Least-squares line through the points `idx` in plan: its centroid and
+/// direction (turned to agree with `hint`).
+fn line_fit(plan: Plan, idx: &[u32], hint: DVec2) -> Option<(DVec2, DVec2)> {
+    let q: Vec<DVec2> = idx.iter().map(|&i| plan.at(i)).collect();
     if q.len() < 2 {
         return None;
     }
@@ -686,7 +704,7 @@ fn line_fit(points: impl Iterator<Item = DVec2>, hint: DVec2) -> Option<(DVec2, 
 /// become one.
 fn merge_faces(faces: &mut Vec<Face>, pts: &[Vec3], origin: DVec3, tol: f64, gap: f64) {
     let cos_parallel = libm::cos(PARALLEL_DEG.to_radians());
-    let plan = |i: u32| (origin + pts[i as usize].as_dvec3()).truncate();
+    let plan = Plan { pts, origin };
     // Groups of faces joined pairwise (union-find, smallest index as root),
     // each fitted once.
     let mut root: Vec<usize> = (0..faces.len()).collect();
@@ -727,7 +745,7 @@ fn merge_faces(faces: &mut Vec<Face>, pts: &[Vec3], origin: DVec3, tol: f64, gap
                 points.sort_unstable();
                 points.dedup();
                 let f = &faces[r];
-                if let Some((at, dir)) = line_fit(points.iter().map(|&k| plan(k)), f.dir) {
+                if let Some((at, dir)) = line_fit(plan, &points, f.dir) {
                     next.push(Face::new(f.lower, f.upper, at, dir, points, plan, tol));
                 }
             }
@@ -802,7 +820,7 @@ fn riser(
     min_area: f64,
 ) -> Option<(Primitive, Vec<u32>)> {
     let world = |i: u32| origin + pts[i as usize].as_dvec3();
-    let (at, dir) = line_fit(piece.iter().map(|&i| world(i).truncate()), face.dir)?;
+    let (at, dir) = line_fit(Plan { pts, origin }, piece, face.dir)?;
     // Upright between the two surfaces, along the line.
     let up = (face.lower.normal + face.upper.normal).normalize_or_zero();
     let normal = dir.extend(0.0).cross(up).normalize_or_zero();
