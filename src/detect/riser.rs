@@ -463,9 +463,9 @@ fn segments(surfaces: &[Option<Surface>], window: Window, p: &Params) -> Vec<Seg
                 // Rounded, not ceiled: outline edges run along the footprint's
                 // cells, so their lengths are often whole cells, where a
                 // ceiling would turn on rounding error.
-                let steps = ((b - a).length() / su.cell).round().max(1.0) as usize;
-                for j in 0..steps {
-                    let q = a.lerp(b, j as f64 / steps as f64);
+                let count = ((b - a).length() / su.cell).round().max(1.0) as usize;
+                for j in 0..count {
+                    let q = a.lerp(b, j as f64 / count as f64);
                     let step = l.plane.signed_distance(q);
                     let plan = q.truncate();
                     let kept = step >= lowest
