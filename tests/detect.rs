@@ -1175,15 +1175,8 @@ fn curbs_between_road_and_sidewalk_are_found() {
         ..CascadePolicy::one_shot()
     };
     let without = Detector::new(&p, policy).run(&cloud.points, cloud.origin, loc.viewpoint());
-    let curbs = |m: &polyscene::eval::Metrics| {
-        let kind = |id: u32| drive.scene().polygons[id as usize].kind;
-        let macro_curbs = m
-            .surfaces
-            .iter()
-            .filter(|s| s.eligible && kind(s.id) == SurfaceKind::Curb);
-        let found = macro_curbs.clone().filter(|s| s.found).count();
-        (found, macro_curbs.count())
-    };
+    let curbs =
+        |m: &polyscene::eval::Metrics| common::found_of_kind(m, drive.scene(), SurfaceKind::Curb);
     let (a, b) = (
         score_location(&with, &gt, &loc),
         score_location(&without, &gt, &loc),

@@ -196,13 +196,8 @@ fn drive_through(layout: Layout) {
     // more; the street's two run the whole 449 m of the scene, and the
     // pieces found cover less than half of what the drive saw of them).
     if layout == Layout::Crossing {
-        let kind = |id: u32| d.scene().polygons[id as usize].kind;
-        let curbs = inc
-            .surfaces
-            .iter()
-            .filter(|s| s.eligible && kind(s.id) == SurfaceKind::Curb);
-        let found = curbs.clone().filter(|s| s.found).count();
-        assert!(found >= 3, "{found} of {} curbs", curbs.count());
+        let (found, all) = common::found_of_kind(&inc, d.scene(), SurfaceKind::Curb);
+        assert!(found >= 3, "{found} of {all} curbs");
     }
     let mean_pose = polyscene::io::mean_position(&d.poses()[..SCANS]).unwrap();
     let cloud = common::cloud(&pts);

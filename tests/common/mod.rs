@@ -10,6 +10,7 @@ use polyscene::geometry::Frame;
 use polyscene::params::{HullKind, Params};
 
 use polyscene::internals::Rng;
+use polyscene::sim::{Scene, SurfaceKind};
 
 /// Sample the rectangle `origin + s*u + t*v`, s in [0, a], t in [0, b], on a
 /// grid of `step` with Gaussian noise `sigma` along `u x v`.
@@ -124,4 +125,18 @@ pub fn check_invariants(cloud: &Cloud, det: &Detection, p: &Params) {
     for (i, prim) in det.primitives.iter().enumerate() {
         assert_eq!(prim.support, counts[i], "support count of {i}");
     }
+}
+
+/// How many of the eligible ground-truth surfaces of `kind` the metrics
+/// `m` (scored against `scene`'s polygons) count as found, and of how many.
+pub fn found_of_kind(
+    m: &polyscene::eval::Metrics,
+    scene: &Scene,
+    kind: SurfaceKind,
+) -> (usize, usize) {
+    let of_kind = m
+        .surfaces
+        .iter()
+        .filter(|s| s.eligible && scene.polygons[s.id as usize].kind == kind);
+    (of_kind.clone().filter(|s| s.found).count(), of_kind.count())
 }
