@@ -35,7 +35,7 @@
 
 use crate::geometry::plane::Moments;
 use crate::geometry::polygon::{make_ccw, segment_distance_sq, signed_area};
-use crate::geometry::{Footprint, Frame, Plane};
+use crate::geometry::{bounds, grow_box, Footprint, Frame, Plane};
 use crate::params::Params;
 use crate::primitive::{Primitive, NO_PRIMITIVE};
 use glam::{DVec2, DVec3, Vec3};
@@ -61,14 +61,19 @@ struct Window {
 
 impl Window {
     fn of(pts: &[Vec3], origin: DVec3, reach: f64) -> Option<Window> {
-        let first = pts.first()?;
-        let (lo, hi) = pts
-            .iter()
-            .fold((*first, *first), |(a, b), &q| (a.min(q), b.max(q)));
+        if pts.is_empty() {
+            return None;
+        }
+        // One pass over the scan's points: the box grows by selects
+        // (`grow_box`), as the other per-point boxes do.
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        for q in pts {
+            grow_box(&mut lo, &mut hi, q.as_dvec3());
+        }
         let grow = DVec2::splat(reach);
         Some(Window {
-            lo: (origin + lo.as_dvec3()).truncate() - grow,
-            hi: (origin + hi.as_dvec3()).truncate() + grow,
+            lo: (origin + lo).truncate() - grow,
+            hi: (origin + hi).truncate() + grow,
         })
     }
 
@@ -374,6 +379,7 @@ fn surfaces(
     p: &Params,
 ) -> Vec<Option<Surface>> {
     let cos_tilt = libm::cos(MAX_TILT_DEG.to_radians());
+    let reach = p.ground.cluster_tolerance.max(p.other.cluster_tolerance);
     primitives
         .iter()
         .zip(bound)
@@ -389,14 +395,9 @@ fn surfaces(
                 };
             }
             let ring = q.vertices();
-            let reach = p.ground.cluster_tolerance.max(p.other.cluster_tolerance);
             let plan: Vec<DVec2> = ring.iter().map(|v| v.truncate()).collect();
-            let lo = plan
-                .iter()
-                .fold(DVec2::splat(f64::INFINITY), |a, &v| a.min(v));
-            let hi = plan
-                .iter()
-                .fold(DVec2::splat(f64::NEG_INFINITY), |a, &v| a.max(v));
+            let (lo, hi) = bounds(&ring);
+            let (lo, hi) = (lo.truncate(), hi.truncate());
             if plan.len() < 3 || !window.meets(lo, hi) {
                 return None;
             }
