@@ -1081,33 +1081,40 @@ fn the_ground_outline_follows_far_rings_as_far_as_they_cluster() {
 /// ground from the cloud's local floor and drops the rules that need a
 /// viewpoint. Before, the origin was taken for the sensor: the road passed
 /// through it edge-on and was rejected as laser rings, and completeness
-/// fell to 0.58 (seed 1). Measured now: road and sidewalks 1,194 m^2 of
-/// ground, completeness 0.79, precision 0.98; with the mean pose as
-/// viewpoint 0.88.
+/// fell to 0.58 (seed 1). Eight locations along the street (scans 10-80):
+/// each keeps its ground; without the viewpoint's rules a horizontal patch
+/// of laser rings can remain here and there, so precision is judged over
+/// all eight. Measured: completeness 0.767-0.830 at each, precision
+/// 0.913-0.988 (0.940 on average).
 #[test]
 fn a_world_frame_location_without_a_viewpoint_keeps_its_ground() {
     let (drive, gt) = drive_truth(polyscene::sim::Layout::Street);
-    let loc = drive.location(20, 10).unwrap();
-    let cloud = Cloud::from_world_f64(&loc.points).unwrap();
     let p = Params::gpp2();
     assert_eq!(p.viewpoint, None);
-    let det = detect(&cloud, &p).unwrap();
-    check_invariants(&cloud, &det, &p);
-    let ground: f64 = det
-        .primitives
-        .iter()
-        .filter(|q| q.ground)
-        .map(|q| q.area)
-        .sum();
-    assert!(ground > 900.0, "ground {ground} m^2");
-    let m = score_location(&det, &gt, &loc);
-    assert!(
-        m.completeness.completeness > 0.72,
-        "{}",
-        m.completeness.completeness
-    );
-    assert!(m.detection.precision > 0.93, "{}", m.detection.precision);
-    assert_eq!(m.duplicates.count, 0);
+    let starts = [10, 20, 30, 40, 50, 60, 70, 80];
+    let mut precision = 0.0;
+    for start in starts {
+        let loc = drive.location(start, 10).unwrap();
+        let cloud = Cloud::from_world_f64(&loc.points).unwrap();
+        let det = detect(&cloud, &p).unwrap();
+        check_invariants(&cloud, &det, &p);
+        let ground: f64 = det
+            .primitives
+            .iter()
+            .filter(|q| q.ground)
+            .map(|q| q.area)
+            .sum();
+        assert!(ground > 900.0, "scan {start}: ground {ground} m^2");
+        let m = score_location(&det, &gt, &loc);
+        assert!(
+            m.completeness.completeness > 0.72,
+            "scan {start}: {}",
+            m.completeness.completeness
+        );
+        assert_eq!(m.duplicates.count, 0, "scan {start}");
+        precision += m.detection.precision / starts.len() as f64;
+    }
+    assert!(precision > 0.93, "{precision}");
 }
 
 /// A street location seen from its mean pose: horizontal planes at the
@@ -1117,37 +1124,53 @@ fn a_world_frame_location_without_a_viewpoint_keeps_its_ground() {
 /// out of play but spares the bands of the surfaces it crosses, and is
 /// not tried again (`CascadePolicy::spare_crossing_surfaces`); without
 /// that, sparse facades and car sides lose a band with every such round.
+/// Local triples (`CascadePolicy::local_triples`) make such planes rarer,
+/// so sparing gains less than it did with triples across the cloud
+/// (recall 0.580 against 0.527 at scan 60 then). Four locations along the
+/// street (scans 20-80), on average: measured recall 0.532 against 0.514,
+/// completeness 0.901 against 0.889, precision 0.994.
 #[test]
 fn a_plane_through_clutter_spares_the_surfaces_it_crosses() {
     use polyscene::detect::{CascadePolicy, Detector};
     let (drive, gt) = drive_truth(polyscene::sim::Layout::Street);
-    let loc = drive.location(60, 10).unwrap();
-    let cloud = Cloud::from_world_f64(&loc.points).unwrap();
-    let p = Params {
-        viewpoint: Some(loc.viewpoint().to_array()),
-        ..Params::gpp2()
-    };
-    let score = |det| score_location(det, &gt, &loc);
-    let with = detect(&cloud, &p).unwrap();
-    check_invariants(&cloud, &with, &p);
-    let policy = CascadePolicy {
-        spare_crossing_surfaces: false,
-        ..CascadePolicy::one_shot()
-    };
-    let without = Detector::new(&p, policy).run(&cloud.points, cloud.origin, loc.viewpoint());
-    let (a, b) = (score(&with), score(&without));
-    // Measured: recall 0.580 against 0.527, completeness 0.905 against
-    // 0.886, precision 1 in both.
-    assert!(a.detection.recall > 0.56, "recall {}", a.detection.recall);
+    let starts = [20, 40, 60, 80];
+    let n = starts.len() as f64;
+    let (mut with_recall, mut without_recall) = (0.0, 0.0);
+    let (mut with_complete, mut without_complete) = (0.0, 0.0);
+    let mut precision = 0.0;
+    for start in starts {
+        let loc = drive.location(start, 10).unwrap();
+        let cloud = Cloud::from_world_f64(&loc.points).unwrap();
+        let p = Params {
+            viewpoint: Some(loc.viewpoint().to_array()),
+            ..Params::gpp2()
+        };
+        let score = |det| score_location(det, &gt, &loc);
+        let with = detect(&cloud, &p).unwrap();
+        check_invariants(&cloud, &with, &p);
+        let policy = CascadePolicy {
+            spare_crossing_surfaces: false,
+            ..CascadePolicy::one_shot()
+        };
+        let without = Detector::new(&p, policy).run(&cloud.points, cloud.origin, loc.viewpoint());
+        let (a, b) = (score(&with), score(&without));
+        assert_eq!(a.duplicates.count, 0, "scan {start}");
+        with_recall += a.detection.recall / n;
+        without_recall += b.detection.recall / n;
+        with_complete += a.completeness.completeness / n;
+        without_complete += b.completeness.completeness / n;
+        precision += a.detection.precision / n;
+    }
+    assert!(with_recall > 0.52, "recall {with_recall}");
     assert!(
-        a.detection.recall > b.detection.recall + 0.03,
-        "recall {} against {}",
-        a.detection.recall,
-        b.detection.recall
+        with_recall > without_recall + 0.015,
+        "recall {with_recall} against {without_recall}"
     );
-    assert!(a.completeness.completeness > b.completeness.completeness + 0.01);
-    assert!(a.detection.precision > 0.99, "{}", a.detection.precision);
-    assert_eq!(a.duplicates.count, 0);
+    assert!(
+        with_complete > without_complete + 0.01,
+        "completeness {with_complete} against {without_complete}"
+    );
+    assert!(precision > 0.99, "{precision}");
 }
 
 /// A curb is a face 15 cm high between the road and the sidewalk: too

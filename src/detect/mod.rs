@@ -268,6 +268,9 @@ impl<'p> Detector<'p> {
         if policy.reject_slivers {
             pool = pool.reject_slivers();
         }
+        if policy.local_triples {
+            pool = pool.local_triples();
+        }
         let mut out = Detection {
             primitives: Vec::new(),
             labels: vec![NO_PRIMITIVE; pts.len()],

@@ -142,6 +142,8 @@ pub struct PlanePool {
     /// to that side (0: any triple not near-collinear; see
     /// [`PlanePool::reject_slivers`]).
     min_fatness: f64,
+    /// Only triples from one voxel (see [`PlanePool::local_triples`]).
+    local_only: bool,
     /// Hypotheses per round, in units of `max_hypotheses` (see
     /// [`PlanePool::hypothesis_scale`]).
     hypothesis_scale: usize,
@@ -272,6 +274,7 @@ impl PlanePool {
             rng,
             near,
             min_fatness: 0.0,
+            local_only: false,
             hypothesis_scale: 1,
             work: 0,
             scored: 0,
@@ -293,6 +296,19 @@ impl PlanePool {
     /// clusters are rejected, and the bands leave play with them.
     pub fn reject_slivers(mut self) -> Self {
         self.min_fatness = MIN_FATNESS;
+        self
+    }
+
+    /// Draw every triple from one voxel: a voxel without three live points
+    /// gives no hypothesis (by default its second and third points then
+    /// come from anywhere in the cloud). A triple across the cloud is a
+    /// plane through unrelated points, and the best of many such is a
+    /// level slab through everything's laser rings at one height (a band
+    /// of each facade and car around, fragments whose clusters are
+    /// rejected), which outscores the sparse surfaces still to be found
+    /// and takes their bands out of play round after round.
+    pub fn local_triples(mut self) -> Self {
+        self.local_only = true;
         self
     }
 
@@ -701,22 +717,28 @@ impl PlanePool {
         }
         let c = self.cell_of[i1 as usize] as usize;
         let members = self.voxels.range(c);
-        let pick = |rng: &mut Rng, not: &[u32]| -> u32 {
+        // The other two points: a few draws from the first one's voxel,
+        // then the first live one there from a random place on
+        // (`local_triples`), or any point of the cloud.
+        let local_only = self.local_only;
+        let pick = |rng: &mut Rng, not: &[u32]| -> Option<u32> {
             for _ in 0..6 {
                 let j = (members.start + rng.below(members.len())) as u32;
                 if self.alive[j as usize] && !not.contains(&j) {
-                    return j;
+                    return Some(j);
                 }
             }
-            let j = self.ridx[rng.below(n)];
-            if self.alive[j as usize] {
-                j
-            } else {
-                i1
+            if local_only {
+                let start = rng.below(members.len());
+                return (0..members.len())
+                    .map(|k| (members.start + (start + k) % members.len()) as u32)
+                    .find(|&j| self.alive[j as usize] && !not.contains(&j));
             }
+            let j = self.ridx[rng.below(n)];
+            Some(if self.alive[j as usize] { j } else { i1 })
         };
-        let i2 = pick(&mut self.rng, &[i1]);
-        let i3 = pick(&mut self.rng, &[i1, i2]);
+        let i2 = pick(&mut self.rng, &[i1])?;
+        let i3 = pick(&mut self.rng, &[i1, i2])?;
         let (p1, p2, p3) = (
             self.cell_pts[i1 as usize].as_dvec3(),
             self.cell_pts[i2 as usize].as_dvec3(),
