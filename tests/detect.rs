@@ -1131,7 +1131,7 @@ fn a_world_frame_location_without_a_viewpoint_keeps_its_ground() {
 /// completeness 0.901 against 0.889, precision 0.994.
 #[test]
 fn a_plane_through_clutter_spares_the_surfaces_it_crosses() {
-    use polyscene::detect::{CascadePolicy, Detector};
+    use polyscene::detect::CascadePolicy;
     let (drive, gt) = drive_truth(polyscene::sim::Layout::Street);
     let starts = [20, 40, 60, 80];
     let n = starts.len() as f64;
@@ -1140,19 +1140,14 @@ fn a_plane_through_clutter_spares_the_surfaces_it_crosses() {
     let mut precision = 0.0;
     for start in starts {
         let loc = drive.location(start, 10).unwrap();
-        let cloud = Cloud::from_world_f64(&loc.points).unwrap();
-        let p = Params {
-            viewpoint: Some(loc.viewpoint().to_array()),
-            ..Params::gpp2()
-        };
+        let (with, without) = with_and_without(
+            &loc,
+            CascadePolicy {
+                spare_crossing_surfaces: false,
+                ..CascadePolicy::one_shot()
+            },
+        );
         let score = |det| score_location(det, &gt, &loc);
-        let with = detect(&cloud, &p).unwrap();
-        check_invariants(&cloud, &with, &p);
-        let policy = CascadePolicy {
-            spare_crossing_surfaces: false,
-            ..CascadePolicy::one_shot()
-        };
-        let without = Detector::new(&p, policy).run(&cloud.points, cloud.origin, loc.viewpoint());
         let (a, b) = (score(&with), score(&without));
         assert_eq!(a.duplicates.count, 0, "scan {start}");
         with_recall += a.detection.recall / n;
@@ -1182,22 +1177,17 @@ fn a_plane_through_clutter_spares_the_surfaces_it_crosses() {
 /// more, none found without the rule.
 #[test]
 fn curbs_between_road_and_sidewalk_are_found() {
-    use polyscene::detect::{CascadePolicy, Detector};
+    use polyscene::detect::CascadePolicy;
     use polyscene::sim::{Layout, SurfaceKind};
     let (drive, gt) = drive_truth(Layout::Crossing);
     let loc = drive.location(80, 10).unwrap();
-    let cloud = Cloud::from_world_f64(&loc.points).unwrap();
-    let p = Params {
-        viewpoint: Some(loc.viewpoint().to_array()),
-        ..Params::gpp2()
-    };
-    let with = detect(&cloud, &p).unwrap();
-    check_invariants(&cloud, &with, &p);
-    let policy = CascadePolicy {
-        find_risers: false,
-        ..CascadePolicy::one_shot()
-    };
-    let without = Detector::new(&p, policy).run(&cloud.points, cloud.origin, loc.viewpoint());
+    let (with, without) = with_and_without(
+        &loc,
+        CascadePolicy {
+            find_risers: false,
+            ..CascadePolicy::one_shot()
+        },
+    );
     let curbs =
         |m: &polyscene::eval::Metrics| common::found_of_kind(m, drive.scene(), SurfaceKind::Curb);
     let (a, b) = (
@@ -1229,6 +1219,24 @@ fn score_location(
     let polys: Vec<_> = det.primitives.iter().map(|q| q.polygon()).collect();
     let (pts, labels) = (&loc.points, &loc.labels);
     evaluate(&polys, gt, pts, labels, pts.len(), &EvalOptions::default()).unwrap()
+}
+
+/// One-shot detection of a location seen from its mean pose, as `detect`
+/// runs it (invariants checked) and with `policy` instead.
+fn with_and_without(
+    loc: &polyscene::sim::Location,
+    policy: polyscene::detect::CascadePolicy,
+) -> (polyscene::detect::Detection, polyscene::detect::Detection) {
+    use polyscene::detect::Detector;
+    let cloud = Cloud::from_world_f64(&loc.points).unwrap();
+    let p = Params {
+        viewpoint: Some(loc.viewpoint().to_array()),
+        ..Params::gpp2()
+    };
+    let with = detect(&cloud, &p).unwrap();
+    check_invariants(&cloud, &with, &p);
+    let without = Detector::new(&p, policy).run(&cloud.points, cloud.origin, loc.viewpoint());
+    (with, without)
 }
 
 /// The simulated drive of a layout (seed 1) and its ground-truth surfaces.
