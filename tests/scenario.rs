@@ -6,6 +6,7 @@ mod common;
 use glam::{DMat4, DVec3};
 use polyscene::detect::{CascadePolicy, Detector, NO_PRIMITIVE};
 use polyscene::eval::{self, EvalOptions, GtSurface};
+use polyscene::geometry::polygon::is_simple;
 use polyscene::geometry::Polygon3;
 use polyscene::params::{HullKind, Params};
 use polyscene::scenario::Scenario;
@@ -61,6 +62,21 @@ fn run(d: &Drive, params: Params) -> Run {
         );
         if k >= 5 {
             shares.push(r.explained_by_expansion as f64 / r.points as f64);
+        }
+        // Every polygon of the map is a region, after every scan: a simple
+        // ring of at least one footprint cell. (A piece of a curb under
+        // `minArea` only ever grows the riser it continues; an outline
+        // traced from one row of cells keeps that row.)
+        let cell = scenario.params().other.cell;
+        for q in scenario.primitives() {
+            assert!(
+                is_simple(&q.outline) && q.area >= cell * cell,
+                "scan {k}: primitive {} of {} m^2, support {}, born {}",
+                q.id,
+                q.area,
+                q.support,
+                q.born_scan
+            );
         }
         if scenario.params().expansion {
             let dups = eval::duplicates(&polygons(&scenario), &opts);

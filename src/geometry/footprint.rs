@@ -22,7 +22,7 @@
 //! uses it is [`crate::outline`]. Both outline methods keep a footprint
 //! (occupancy, merging and expansion read it), so it stays here.
 
-use super::polygon::{is_simple, make_ccw, remove_collinear, simplify};
+use super::polygon::{is_simple, make_ccw, remove_collinear, signed_area, simplify};
 use crate::raster::{trace_region, BitGrid};
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
@@ -534,9 +534,13 @@ impl Footprint {
             // The traced ring runs along the outer edges of the boundary cells,
             // half a cell beyond the points on average: move it in by half a
             // cell (through the boundary cells' centres), unless that would
-            // collapse a one-cell-wide part.
+            // collapse a one-cell-wide part or, in rounding, the whole ring:
+            // a region one cell wide everywhere (a curb's face seen along one
+            // laser ring) insets to a line, which rounding left as a ring of
+            // area 1e-17 that passes as simple. An inset that keeps a
+            // region keeps at least a cell's area (a 2 x 2 block gives one).
             let inset = inset_rectilinear(&ring, 0.5 * cs);
-            if is_simple(&inset) {
+            if is_simple(&inset) && signed_area(&inset) >= 0.5 * cs * cs {
                 ring = inset;
             }
             let mut out = simplify(&ring, tolerance.max(0.0), max_vertices);
@@ -638,6 +642,25 @@ mod tests {
         assert_eq!(small.mark_all(&[DVec2::new(1.0, 1.0)]), 1);
         assert!(small.is_set(DVec2::new(1.0, 1.0)));
         let _ = small.outline(0.5, 0.1, 64);
+    }
+
+    #[test]
+    fn a_strip_one_cell_wide_keeps_its_area() {
+        // A laser ring across a curb's face: points along one row of cells.
+        // The half-cell inset takes the ring to a line; at some rows of
+        // these 120 m, rounding left that line a ring of area ~1e-17 that
+        // passed as simple. The outline is the traced strip instead.
+        for row in -300..300 {
+            let y = row as f64 * 0.2 + 0.0137;
+            let mut fp = Footprint::new(0.2);
+            let pts: Vec<DVec2> = (0..9)
+                .map(|i| DVec2::new(-26.7565 + 0.0247 * i as f64, y))
+                .collect();
+            fp.mark_all(&pts);
+            let ring = fp.outline(0.5, 0.1, 64).unwrap();
+            assert!(is_simple(&ring), "{ring:?}");
+            assert!(signed_area(&ring) >= 0.039, "{y}: {ring:?}");
+        }
     }
 
     #[test]

@@ -7,7 +7,7 @@ use crate::primitive::Primitive;
 use glam::DVec2;
 
 /// Absorb `b` into `a`.
-fn absorb(a: &mut Primitive, b: &Primitive, params: &Params) {
+pub(crate) fn absorb(a: &mut Primitive, b: &Primitive, params: &Params) {
     a.moments.merge(&b.moments);
     let old_normal = a.plane.normal;
     if let Some((mut plane, _)) = a.moments.fit_plane() {

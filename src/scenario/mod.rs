@@ -392,8 +392,9 @@ impl Scenario {
     /// points (the first `n` of `cloud`; a curb's face lies within the
     /// expansion gates of the road and the sidewalk, so the pool holds
     /// little of it), which they take from the primitive they were
-    /// labelled with. Each becomes a new primitive; the merge then joins
-    /// it to the riser an earlier scan found there.
+    /// labelled with. A riser of `minArea` becomes a new primitive (the
+    /// merge then joins it to one an earlier scan found there); a smaller
+    /// piece grows the primitive it continues, or is dropped.
     #[allow(clippy::too_many_arguments)]
     fn add_risers(
         &mut self,
@@ -427,28 +428,43 @@ impl Scenario {
             p,
             0.0,
         );
-        // Those large enough first, then the pieces too small to stand alone
-        // (a scan sees a few metres of a curb) that continue a riser in
-        // view or just added, and merge into it.
+        // Those large enough first, each a new primitive; then the pieces
+        // too small to stand alone (a scan sees a few metres of a curb),
+        // each taken into the primitive it continues (`merge::mergeable`:
+        // a riser in view or one just added) at once, or dropped. A small
+        // piece never stands alone, not even until the merge step: there it
+        // could miss the primitive it continued (merged into another
+        // first) and stay, a few centimetres wide.
         let (large, small): (Vec<_>, Vec<_>) =
             found.into_iter().partition(|(r, _)| r.area >= p.min_area);
         let mut ids: Vec<u32> = near.to_vec();
         for (mut riser, points) in large.into_iter().chain(small) {
-            if riser.area < p.min_area
-                && !ids.iter().any(|&id| {
+            // The slot of the primitive a small piece continues.
+            let into = if riser.area < p.min_area {
+                let continued = ids.iter().find_map(|&id| {
                     index_of(&self.primitives, id)
-                        .is_some_and(|k| crate::merge::mergeable(&self.primitives[k], &riser, p))
-                })
-            {
-                continue;
-            }
-            riser.id = self.next_id;
-            self.next_id += 1;
+                        .filter(|&k| crate::merge::mergeable(&self.primitives[k], &riser, p))
+                });
+                if continued.is_none() {
+                    continue;
+                }
+                continued
+            } else {
+                None
+            };
             riser.born_scan = scan;
             riser.last_scan = scan;
+            let id = match into {
+                Some(k) => self.primitives[k].id,
+                None => {
+                    riser.id = self.next_id;
+                    self.next_id += 1;
+                    riser.id
+                }
+            };
             for &i in &points {
                 let i = i as usize;
-                let old = std::mem::replace(&mut labels[i], riser.id);
+                let old = std::mem::replace(&mut labels[i], id);
                 match index_of(&self.primitives, old) {
                     Some(k) => {
                         let q = &mut self.primitives[k];
@@ -458,10 +474,22 @@ impl Scenario {
                 }
                 alive[i] = false;
             }
-            report.added.push(riser.id);
-            ids.push(riser.id);
-            self.index.update(&riser);
-            self.primitives.push(riser);
+            match into {
+                Some(k) => {
+                    let q = &mut self.primitives[k];
+                    crate::merge::stats::absorb(q, &riser, p);
+                    self.index.update(q);
+                    if !report.added.contains(&id) && !report.grown.contains(&id) {
+                        report.grown.push(id);
+                    }
+                }
+                None => {
+                    report.added.push(id);
+                    ids.push(id);
+                    self.index.update(&riser);
+                    self.primitives.push(riser);
+                }
+            }
         }
     }
 
