@@ -6,7 +6,7 @@ use crate::floor::GroundRule;
 use crate::geometry::plane::{robust_fit, RobustFit};
 use crate::geometry::polygon::signed_area;
 use crate::geometry::{convex_hull, Footprint, Frame, Moments, Plane, Polygon3};
-use crate::params::{Params, SolidityKind};
+use crate::params::{HullKind, Params, SolidityKind};
 use glam::{DVec2, DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 
@@ -110,6 +110,13 @@ impl Primitive {
     /// `extra` are new support points (frame coordinates) for convex hulls.
     /// Returns false (leaving the primitive unchanged) when no outline exists.
     pub(crate) fn reshape(&mut self, params: &Params, extra: &[DVec2]) -> bool {
+        if params.hull == HullKind::Concave {
+            if let Some(r) = self.thin_rectangle() {
+                self.area = signed_area(&r);
+                self.outline = r;
+                return true;
+            }
+        }
         let ring = params.hull.grown(
             &self.outline,
             extra,
@@ -126,6 +133,66 @@ impl Primitive {
             }
             _ => false,
         }
+    }
+}
+
+impl Primitive {
+    /// The direction of the outline's long side and its width across it
+    /// (rotating calipers over the hull edges); `None` without a hull.
+    fn long_side(&self) -> Option<(DVec2, f64)> {
+        let hull = convex_hull(&self.outline)?;
+        let n = hull.len();
+        let (mut best, mut along) = (f64::INFINITY, DVec2::X);
+        for i in 0..n {
+            let e = crate::geometry::unit_or_zero(hull[(i + 1) % n] - hull[i]);
+            if e == DVec2::ZERO {
+                continue;
+            }
+            let w = hull
+                .iter()
+                .map(|&p| e.perp_dot(p - hull[i]))
+                .fold(0.0, f64::max);
+            if w < best {
+                (best, along) = (w, e);
+            }
+        }
+        best.is_finite().then_some((along, best))
+    }
+
+    /// The outline of a primitive narrower than two footprint cells (a
+    /// curb's or a step's 15 cm face, whose outline is the rectangle
+    /// between the two surfaces it joins) grown to the footprint: the same
+    /// rectangle, across its narrow side as it was, along its long side
+    /// out to the centres of the footprint's end cells. The raster cannot
+    /// hold such a face: traced, one row of 0.2 m cells is more than its
+    /// height, and only the largest region the closing joins is kept (the
+    /// simulated crossing's curbs, with gaps of up to 1 m between a ring's
+    /// points, traced to a tenth of their rectangles: 0.16 of 1.76 m^2).
+    /// `None` for an outline two cells wide or more.
+    fn thin_rectangle(&self) -> Option<Vec<DVec2>> {
+        let (along, best) = self.long_side()?;
+        let cell = self.footprint.cell();
+        if best >= 2.0 * cell {
+            return None;
+        }
+        let hull = convex_hull(&self.outline)?;
+        let across = along.perp();
+        let span = |pts: &mut dyn Iterator<Item = DVec2>, dir: DVec2| {
+            pts.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                let t = p.dot(dir);
+                (lo.min(t), hi.max(t))
+            })
+        };
+        let (c0, c1) = span(&mut hull.iter().copied(), across);
+        let centres = self.footprint.cell_centres();
+        let (a0, a1) = span(&mut hull.iter().copied().chain(centres), along);
+        if !(a1 > a0 && c1 > c0) {
+            return None;
+        }
+        let at = |a: f64, c: f64| along * a + across * c;
+        let mut ring = vec![at(a0, c0), at(a1, c0), at(a1, c1), at(a0, c1)];
+        crate::geometry::polygon::make_ccw(&mut ring);
+        Some(ring)
     }
 }
 
@@ -366,4 +433,81 @@ pub(crate) fn shape(
         roughness,
         q,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::polygon::is_simple;
+
+    /// A curb's face as the riser step makes it: the 15 cm rectangle over
+    /// x in [0, 3] (frame coordinates: x along the curb, y up), with its
+    /// support's cells.
+    fn riser() -> Primitive {
+        let plane = Plane::from_point_normal(DVec3::ZERO, DVec3::Y);
+        let frame = Frame::on_plane(&plane, DVec3::ZERO);
+        let outline = vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(3.0, 0.0),
+            DVec2::new(3.0, 0.15),
+            DVec2::new(0.0, 0.15),
+        ];
+        let mut footprint = Footprint::new(0.2);
+        let pts: Vec<DVec2> = (0..30)
+            .map(|i| DVec2::new(0.05 + 0.1 * i as f64, 0.07))
+            .collect();
+        footprint.mark_all(&pts);
+        Primitive {
+            id: 1,
+            plane,
+            frame,
+            area: signed_area(&outline),
+            outline,
+            support: 30,
+            ground: false,
+            moments: Moments::new(DVec3::ZERO),
+            footprint,
+            born_scan: 0,
+            last_scan: 0,
+        }
+    }
+
+    #[test]
+    fn a_face_narrower_than_two_cells_grows_as_a_rectangle() {
+        let mut r = riser();
+        // The next scan sees the curb continue to x = 5, a little lower in
+        // the cells (the ring falls elsewhere on the face).
+        let more: Vec<DVec2> = (0..20)
+            .map(|i| DVec2::new(3.05 + 0.1 * i as f64, 0.02))
+            .collect();
+        r.footprint.mark_all(&more);
+        assert!(r.reshape(&Params::gpp2(), &more));
+        // The 15 cm face out to the last cell's centre (x = 4.9): traced
+        // from the cells it would be 0.2 m high, or pieces of that.
+        assert!(is_simple(&r.outline));
+        assert!(
+            (min_width(&r.outline) - 0.15).abs() < 1e-9,
+            "{:?}",
+            r.outline
+        );
+        assert!((r.area - 0.15 * 4.9).abs() < 1e-9, "{}", r.area);
+    }
+
+    #[test]
+    fn a_face_two_cells_wide_is_traced() {
+        let mut r = riser();
+        r.outline = vec![
+            DVec2::new(0.0, 0.0),
+            DVec2::new(3.0, 0.0),
+            DVec2::new(3.0, 0.6),
+            DVec2::new(0.0, 0.6),
+        ];
+        let more: Vec<DVec2> = (0..30)
+            .flat_map(|i| [0.25, 0.45].map(|y| DVec2::new(0.05 + 0.1 * i as f64, y)))
+            .collect();
+        r.footprint.mark_all(&more);
+        assert!(r.thin_rectangle().is_none());
+        assert!(r.reshape(&Params::gpp2(), &more));
+        assert!(r.outline.len() >= 4 && r.area > 0.0);
+    }
 }
