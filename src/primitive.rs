@@ -168,7 +168,7 @@ impl Primitive {
     /// height, and only the largest region the closing joins is kept (the
     /// simulated crossing's curbs, with gaps of up to 1 m between a ring's
     /// points, traced to a tenth of their rectangles: 0.16 of 1.76 m^2).
-    /// `None` for an outline two cells wide or more.
+    /// `None` for an outline, or support cells, two cells wide or more.
     fn thin_rectangle(&self) -> Option<Vec<DVec2>> {
         let (along, best) = self.long_side()?;
         let cell = self.footprint.cell();
@@ -183,8 +183,14 @@ impl Primitive {
                 (lo.min(t), hi.max(t))
             })
         };
-        let (c0, c1) = span(&mut hull.iter().copied(), across);
         let centres = self.footprint.cell_centres();
+        // The support too must be a strip: a wide surface merged into a
+        // riser in its plane (a wall standing on a curb's line) is traced.
+        let (s0, s1) = span(&mut centres.iter().copied(), across);
+        if s1 - s0 >= 2.0 * cell {
+            return None;
+        }
+        let (c0, c1) = span(&mut hull.iter().copied(), across);
         let (a0, a1) = span(&mut hull.iter().copied().chain(centres), along);
         if !(a1 > a0 && c1 > c0) {
             return None;
@@ -509,5 +515,22 @@ mod tests {
         assert!(r.thin_rectangle().is_none());
         assert!(r.reshape(&Params::gpp2(), &more));
         assert!(r.outline.len() >= 4 && r.area > 0.0);
+    }
+
+    #[test]
+    fn a_wide_surface_merged_into_a_face_is_traced() {
+        // A wall 1 m high standing on the curb's line, in the riser's
+        // plane: its cells make the support wide, and the outline follows
+        // them instead of squashing the wall into the curb's 15 cm.
+        let mut r = riser();
+        let wall: Vec<DVec2> = (0..30)
+            .flat_map(|i| {
+                (0..10).map(move |j| DVec2::new(0.05 + 0.1 * i as f64, 0.05 + 0.1 * j as f64))
+            })
+            .collect();
+        r.footprint.mark_all(&wall);
+        assert!(r.thin_rectangle().is_none());
+        assert!(r.reshape(&Params::gpp2(), &wall));
+        assert!(r.area > 2.0, "{}", r.area);
     }
 }

@@ -538,7 +538,8 @@ impl Footprint {
             // a region one cell wide everywhere (a curb's face seen along one
             // laser ring) insets to a line, which rounding left as a ring of
             // area 1e-17 that passes as simple. An inset that keeps a
-            // region keeps at least a cell's area (a 2 x 2 block gives one).
+            // region keeps at least half a cell's area (a 2 x 2 block of
+            // cells insets to one cell).
             let inset = inset_rectilinear(&ring, 0.5 * cs);
             if is_simple(&inset) && signed_area(&inset) >= 0.5 * cs * cs {
                 ring = inset;
