@@ -301,12 +301,12 @@ fn drive_through(layout: Layout) {
     assert!(inc.duplicates.count <= shot.duplicates.count, "duplicates");
     // polyscene's one-shot on the whole drive (measured: street
     // P 0.988 R 0.477 C 0.869, 3 duplicate pairs; crossing P 0.989
-    // R 0.487 C 0.863, 2): the scenario finds more of the scene (1.50x
+    // R 0.487 C 0.863, 2): the scenario finds more of the scene (1.51x
     // and 1.15x the surfaces; 1.76x and 1.46x before one-shot detection
     // drew its triples from one voxel only), without duplicates, and
-    // stays as precise (P 0.995 on both). The one-shot's area-weighted
-    // mean error is the lower one (street 4.0 vs 4.9 mm, crossing 4.1 vs
-    // 4.6 mm): it fits each surface to the whole
+    // stays as precise (P 0.990 and 0.991). The one-shot's area-weighted
+    // mean error is the lower one (street 4.0 vs 5.3 mm, crossing 4.1 vs
+    // 4.4 mm): it fits each surface to the whole
     // drive at once, and leaves out most of the vehicle faces. So the mean
     // is not compared here; BENCHMARKS.md gives both. The scenario must
     // cover at least nine tenths of what the one-shot covers (it covers
