@@ -134,30 +134,6 @@ impl Primitive {
             _ => false,
         }
     }
-}
-
-impl Primitive {
-    /// The direction of the outline's long side and its width across it
-    /// (rotating calipers over the hull edges); `None` without a hull.
-    fn long_side(&self) -> Option<(DVec2, f64)> {
-        let hull = convex_hull(&self.outline)?;
-        let n = hull.len();
-        let (mut best, mut along) = (f64::INFINITY, DVec2::X);
-        for i in 0..n {
-            let e = crate::geometry::unit_or_zero(hull[(i + 1) % n] - hull[i]);
-            if e == DVec2::ZERO {
-                continue;
-            }
-            let w = hull
-                .iter()
-                .map(|&p| e.perp_dot(p - hull[i]))
-                .fold(0.0, f64::max);
-            if w < best {
-                (best, along) = (w, e);
-            }
-        }
-        best.is_finite().then_some((along, best))
-    }
 
     /// The outline of a primitive narrower than two footprint cells (a
     /// curb's or a step's 15 cm face, whose outline is the rectangle
@@ -170,28 +146,22 @@ impl Primitive {
     /// points, traced to a tenth of their rectangles: 0.16 of 1.76 m^2).
     /// `None` for an outline, or support cells, two cells wide or more.
     fn thin_rectangle(&self) -> Option<Vec<DVec2>> {
-        let (along, best) = self.long_side()?;
+        let hull = convex_hull(&self.outline)?;
+        let (width, along) = narrowest(&hull);
         let cell = self.footprint.cell();
-        if best >= 2.0 * cell {
+        if width >= 2.0 * cell {
             return None;
         }
-        let hull = convex_hull(&self.outline)?;
         let across = along.perp();
-        let span = |pts: &mut dyn Iterator<Item = DVec2>, dir: DVec2| {
-            pts.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
-                let t = p.dot(dir);
-                (lo.min(t), hi.max(t))
-            })
-        };
         let centres = self.footprint.cell_centres();
         // The support too must be a strip: a wide surface merged into a
         // riser in its plane (a wall standing on a curb's line) is traced.
-        let (s0, s1) = span(&mut centres.iter().copied(), across);
+        let (s0, s1) = span(centres.iter().copied(), across);
         if s1 - s0 >= 2.0 * cell {
             return None;
         }
-        let (c0, c1) = span(&mut hull.iter().copied(), across);
-        let (a0, a1) = span(&mut hull.iter().copied().chain(centres), along);
+        let (c0, c1) = span(hull.iter().copied(), across);
+        let (a0, a1) = span(hull.iter().copied().chain(centres), along);
         if !(a1 > a0 && c1 > c0) {
             return None;
         }
@@ -202,27 +172,40 @@ impl Primitive {
     }
 }
 
+/// The least and greatest of the points' coordinates along `dir`.
+fn span(pts: impl Iterator<Item = DVec2>, dir: DVec2) -> (f64, f64) {
+    pts.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+        let t = p.dot(dir);
+        (if t < lo { t } else { lo }, if t > hi { t } else { hi })
+    })
+}
+
 /// Smallest width of the outline's convex hull (rotating calipers over the
 /// hull edges), in metres.
 pub fn min_width(ring: &[DVec2]) -> f64 {
-    let Some(h) = convex_hull(ring) else {
-        return 0.0;
-    };
+    convex_hull(ring).map_or(0.0, |h| narrowest(&h).0)
+}
+
+/// The smallest width of a convex hull and the direction of the hull edge
+/// it is measured from (rotating calipers over the edges).
+fn narrowest(h: &[DVec2]) -> (f64, DVec2) {
     let n = h.len();
-    let mut best = f64::INFINITY;
+    let (mut best, mut along) = (f64::INFINITY, DVec2::X);
     for i in 0..n {
         let (a, b) = (h[i], h[(i + 1) % n]);
         let e = crate::geometry::unit_or_zero(b - a);
         // Comparisons, not `f64::max`/`min` (which also test for NaN in
         // wasm): the same result (a NaN would be skipped by both).
         let mut w = 0.0f64;
-        for &p in &h {
+        for &p in h {
             let d = e.perp_dot(p - a);
             w = if d > w { d } else { w };
         }
-        best = if w < best { w } else { best };
+        if w < best {
+            (best, along) = (w, e);
+        }
     }
-    best
+    (best, along)
 }
 
 /// The result of shaping a support set: the primitive (id 0, scans 0) and

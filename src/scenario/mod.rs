@@ -445,10 +445,8 @@ impl Scenario {
                     index_of(&self.primitives, id)
                         .filter(|&k| crate::merge::mergeable(&self.primitives[k], &riser, p))
                 });
-                if continued.is_none() {
-                    continue;
-                }
-                continued
+                let Some(k) = continued else { continue };
+                Some(k)
             } else {
                 None
             };
