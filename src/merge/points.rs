@@ -37,6 +37,14 @@ pub(crate) fn merge_pieces(
     if n < 2 {
         return;
     }
+    // The points of each primitive, in increasing order, kept with the
+    // labels: a merge then reads its pieces' points, not every label.
+    let mut members: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for (i, &l) in labels.iter().enumerate() {
+        if l != NO_PRIMITIVE {
+            members[l as usize].push(i as u32);
+        }
+    }
     let mut into: Vec<u32> = (0..n as u32).collect();
     let mut grown = vec![true; n];
     for _ in 0..n {
@@ -67,7 +75,16 @@ pub(crate) fn merge_pieces(
             // A piece that would lose too much support stays apart; the
             // others still merge.
             while !group.is_empty() {
-                match absorb(primitives, labels, big, &group, pts, origin, p) {
+                match absorb(
+                    primitives,
+                    labels,
+                    &mut members,
+                    big,
+                    &group,
+                    pts,
+                    origin,
+                    p,
+                ) {
                     Ok(out) => {
                         primitives[big] = out;
                         for &j in &group {
@@ -121,10 +138,13 @@ pub(crate) fn merge_pieces(
 /// Each piece must keep nine tenths of its support within the inlier
 /// distance of the plane and inside the new raster region, and so must the
 /// largest (the larger footprint's trace can simplify another way); the
-/// points that do not lose their label. Labels are changed only on success.
+/// points that do not lose their label. Labels (and `members`, the points
+/// of each primitive in increasing order) are changed only on success.
+#[allow(clippy::too_many_arguments)]
 fn absorb(
     primitives: &[Primitive],
     labels: &mut [u32],
+    members: &mut [Vec<u32>],
     big: usize,
     group: &[usize],
     pts: &[Vec3],
@@ -139,18 +159,19 @@ fn absorb(
     // lie on its plane.
     let mut taken: Vec<(usize, Option<DVec2>)> = Vec::new();
     let (mut total, mut bad) = (vec![0usize; n], vec![0usize; n]);
-    let mut in_group = vec![false; n];
-    for &j in group {
-        in_group[j] = true;
-    }
-    for (i, &l) in labels.iter().enumerate() {
-        if l != NO_PRIMITIVE && in_group[l as usize] {
-            let w = world(i);
-            let on = out.plane.signed_distance(w).abs() < threshold;
-            total[l as usize] += 1;
-            bad[l as usize] += !on as usize;
-            taken.push((i, on.then(|| out.frame.to_local(w))));
-        }
+    // In increasing order, as the labels hold them: the moments removed
+    // below sum in that order.
+    let mut pieces: Vec<u32> = group
+        .iter()
+        .flat_map(|&j| members[j].iter().copied())
+        .collect();
+    pieces.sort_unstable();
+    for i in pieces.into_iter().map(|i| i as usize) {
+        let (l, w) = (labels[i] as usize, world(i));
+        let on = out.plane.signed_distance(w).abs() < threshold;
+        total[l] += 1;
+        bad[l] += !on as usize;
+        taken.push((i, on.then(|| out.frame.to_local(w))));
     }
     let marks: Vec<DVec2> = taken.iter().filter_map(|t| t.1).collect();
     out.footprint.mark_all(&marks);
@@ -181,13 +202,11 @@ fn absorb(
         .all(|&c| region.contains(c));
     let mut own_out = Vec::new();
     if !keeps_own {
-        let mut own = 0usize;
-        for (i, &l) in labels.iter().enumerate() {
-            if l == big as u32 {
-                own += 1;
-                if !region.contains(out.frame.to_local(world(i))) {
-                    own_out.push(i);
-                }
+        let own = members[big].len();
+        for &i in &members[big] {
+            let i = i as usize;
+            if !region.contains(out.frame.to_local(world(i))) {
+                own_out.push(i);
             }
         }
         if 10 * own_out.len() > own {
@@ -212,6 +231,22 @@ fn absorb(
         gone.push(world(i));
     }
     out.support = out.support.saturating_sub(own_out.len() as u64);
+    let mut now: Vec<u32> = taken
+        .iter()
+        .zip(&kept)
+        .filter_map(|(&(i, _), &stay)| stay.then_some(i as u32))
+        .chain(
+            members[big]
+                .iter()
+                .copied()
+                .filter(|&i| labels[i as usize] == big as u32),
+        )
+        .collect();
+    now.sort_unstable();
+    members[big] = now;
+    for &j in group {
+        members[j].clear();
+    }
     for &j in group {
         out.moments.merge(&primitives[j].moments);
     }
