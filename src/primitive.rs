@@ -101,9 +101,14 @@ impl Primitive {
             }
     }
 
-    /// Outline radius used for this primitive (m).
+    /// Outline radius used for this primitive (m): the parameters' radius
+    /// for its kind of surface, in the same ratio to its footprint's cell
+    /// as to the parameters' cell (one-shot detection's coarse pass traces
+    /// sparse surfaces on coarser cells).
     pub fn alpha(&self, params: &Params) -> f64 {
-        params.surface(self.ground).alpha
+        let s = params.surface(self.ground);
+        // The ratio is exactly 1 for the usual footprint.
+        s.alpha * (self.footprint.cell() / s.cell)
     }
 
     /// Recompute the outline after the footprint or hull points changed.

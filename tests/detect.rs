@@ -1107,7 +1107,7 @@ fn a_world_frame_location_without_a_viewpoint_keeps_its_ground() {
         assert!(ground > 900.0, "scan {start}: ground {ground} m^2");
         let m = score_location(&det, &gt, &loc);
         assert!(
-            m.completeness.completeness > 0.72,
+            m.completeness.completeness > 0.85,
             "scan {start}: {}",
             m.completeness.completeness
         );
@@ -1435,4 +1435,68 @@ fn a_ramp_and_the_plateau_it_climbs_to_are_found_without_a_viewpoint() {
     ] {
         assert_area_on(&det, name, normal, at, 0.03, [0.85 * want, 1.1 * want]);
     }
+}
+
+/// A street location seen from nowhere, as a map accumulated over the
+/// drive: the facades 40-100 m down the street hold a few laser rings
+/// half a metre apart with metre gaps along each, which the first pass's
+/// clustering breaks into fragments. The coarse pass
+/// (`CascadePolicy::coarse_pass`) finds them on the points that lie too
+/// sparsely for it, and merges them with the pieces of the same surfaces
+/// the first pass found. Eight locations along the street (scans 10-80),
+/// on average: measured recall 0.568 against 0.542, completeness 0.910
+/// against 0.804 (higher at every location), precision 0.944 against
+/// 0.940.
+#[test]
+fn a_map_s_sparse_far_surfaces_are_found_at_a_coarser_scale() {
+    use polyscene::detect::{CascadePolicy, Detector};
+    let (drive, gt) = drive_truth(polyscene::sim::Layout::Street);
+    let p = Params::gpp2();
+    let starts = [10, 20, 30, 40, 50, 60, 70, 80];
+    let n = starts.len() as f64;
+    let (mut with, mut without) = ([0.0; 3], [0.0; 3]);
+    for start in starts {
+        let loc = drive.location(start, 10).unwrap();
+        let cloud = Cloud::from_world_f64(&loc.points).unwrap();
+        let a = detect(&cloud, &p).unwrap();
+        check_invariants(&cloud, &a, &p);
+        let far = cloud.origin
+            + cloud
+                .points
+                .iter()
+                .map(|q| q.as_dvec3())
+                .sum::<glam::DVec3>()
+                / cloud.len() as f64
+            + glam::DVec3::new(0.0, 0.0, 1e4);
+        let policy = CascadePolicy {
+            coarse_pass: false,
+            ..CascadePolicy::one_shot().without_viewpoint()
+        };
+        let b = Detector::new(&p, policy).run(&cloud.points, cloud.origin, far);
+        let (a, b) = (score_location(&a, &gt, &loc), score_location(&b, &gt, &loc));
+        assert_eq!(a.duplicates.count, 0, "scan {start}");
+        for (s, m) in [(&mut with, &a), (&mut without, &b)] {
+            s[0] += m.detection.recall / n;
+            s[1] += m.completeness.completeness / n;
+            s[2] += m.detection.precision / n;
+        }
+        assert!(
+            a.completeness.completeness > b.completeness.completeness + 0.05,
+            "scan {start}: completeness {} against {}",
+            a.completeness.completeness,
+            b.completeness.completeness
+        );
+    }
+    assert!(
+        with[0] > without[0] + 0.015,
+        "recall {with:?} against {without:?}"
+    );
+    assert!(
+        with[1] > without[1] + 0.08,
+        "completeness {with:?} against {without:?}"
+    );
+    assert!(
+        with[2] >= without[2],
+        "precision {with:?} against {without:?}"
+    );
 }

@@ -5,6 +5,7 @@
 //! live in `round`, the plane search in [`ransac`].
 
 pub(crate) mod cluster;
+mod coarse;
 pub mod kernels;
 mod policy;
 pub mod ransac;
@@ -257,6 +258,60 @@ impl<'p> Detector<'p> {
             Some(f) => GroundRule::LocalFloor(f),
             None => GroundRule::BelowViewpoint,
         };
+        // The coarse pass's generator, derived from the cascade's first
+        // draw: an explicit generator fixes both.
+        let coarse_rng = Rng::derive(rng.clone().next_u64(), coarse::STREAM);
+        let (mut out, stopped) = self.rounds(pts, origin, viewpoint, ground, rng, progress);
+        if stopped {
+            return (out, true);
+        }
+        // 7. A coarser cascade on the points too sparse for this one.
+        if policy.coarse_pass
+            && coarse::pass(
+                self, &mut out, pts, origin, viewpoint, ground, coarse_rng, progress,
+            )
+        {
+            return (out, true);
+        }
+        // 8. Merge the pieces of one surface that rounds or passes found
+        //    apart.
+        if policy.merge_pieces && p.hull.merges_detected_pieces() {
+            crate::merge::points::merge_pieces(
+                &mut out.primitives,
+                &mut out.labels,
+                pts,
+                origin,
+                p,
+            );
+        }
+        // 9. The risers between near-horizontal surfaces a step apart.
+        if policy.find_risers {
+            riser::add_risers(
+                &mut out.primitives,
+                &mut out.labels,
+                pts,
+                origin,
+                viewpoint,
+                p,
+            );
+        }
+        out.time_ms = clock::now_ms() - t0;
+        (out, false)
+    }
+
+    /// The rounds of the cascade (steps 1-6) on `pts` until a stop rule,
+    /// with `progress` called after each; the flag: stopped by `progress`.
+    fn rounds(
+        &self,
+        pts: &[Vec3],
+        origin: DVec3,
+        viewpoint: DVec3,
+        ground: GroundRule,
+        rng: Rng,
+        progress: &mut dyn FnMut(&Progress) -> ControlFlow<()>,
+    ) -> (Detection, bool) {
+        let (p, policy) = (self.params, &self.policy);
+        let t0 = clock::now_ms();
         let local_viewpoint = viewpoint - origin;
         let mut pool = PlanePool::new(
             pts,
@@ -412,27 +467,6 @@ impl<'p> Detector<'p> {
             if progress(&at).is_break() {
                 return (out, true);
             }
-        }
-        // 7. Merge the pieces of one surface that rounds found apart.
-        if policy.merge_pieces && p.hull.merges_detected_pieces() {
-            crate::merge::points::merge_pieces(
-                &mut out.primitives,
-                &mut out.labels,
-                pts,
-                origin,
-                p,
-            );
-        }
-        // 8. The risers between near-horizontal surfaces a step apart.
-        if policy.find_risers {
-            riser::add_risers(
-                &mut out.primitives,
-                &mut out.labels,
-                pts,
-                origin,
-                viewpoint,
-                p,
-            );
         }
         out.work = pool.work;
         out.time_ms = clock::now_ms() - t0;

@@ -173,7 +173,29 @@ fn absorb(
         bad[l] += !on as usize;
         taken.push((i, on.then(|| out.frame.to_local(w))));
     }
-    let marks: Vec<DVec2> = taken.iter().filter_map(|t| t.1).collect();
+    let mut marks: Vec<DVec2> = taken.iter().filter_map(|t| t.1).collect();
+    // A piece traced on coarser cells (one-shot detection's coarse pass)
+    // marks its cells whole: its points alone, on `big`'s finer cells,
+    // would leave the holes its outline closed.
+    let fine = out.footprint.cell();
+    for &j in group {
+        let piece = &primitives[j];
+        let coarse = piece.footprint.cell();
+        if coarse > fine {
+            let n = (coarse / fine).ceil() as usize;
+            let offsets: Vec<f64> = (0..n)
+                .map(|k| ((k as f64 + 0.5) / n as f64 - 0.5) * coarse)
+                .collect();
+            for c in piece.footprint.cell_centres() {
+                for &dx in &offsets {
+                    for &dy in &offsets {
+                        let w = piece.frame.to_world(c + DVec2::new(dx, dy));
+                        marks.push(out.frame.to_local(w));
+                    }
+                }
+            }
+        }
+    }
     out.footprint.mark_all(&marks);
     let (ring, region) = out
         .footprint
@@ -296,6 +318,45 @@ mod tests {
     /// Two primitives shaped from two patches.
     fn two(a: &[Vec3], b: &[Vec3], p: &Params) -> (Vec<Primitive>, Vec<u32>, Vec<Vec3>) {
         pieces(&[a, b], p)
+    }
+
+    /// A far part of a facade found by one-shot detection's coarse pass
+    /// (cells and outline radius three times the first pass's) merges into
+    /// the near part the first pass found: its points alone, on the near
+    /// part's finer cells, lie a metre apart and would not hold together.
+    #[test]
+    fn a_piece_on_coarser_cells_merges_whole() {
+        let p = Params::gpp2();
+        let mut coarse = p.clone();
+        coarse.other.cell *= 3.0;
+        coarse.other.alpha *= 3.0;
+        let near = patch(0.0, 14.0, 0.0, 0.0);
+        let mut far = Vec::new();
+        for i in 0..8 {
+            for k in 0..3 {
+                far.push(Vec3::new(14.05 + i as f32, 0.0, 0.1 + 0.9 * k as f32));
+            }
+        }
+        let view = DVec3::new(2.0, -6.0, 1.5);
+        let mut prims = Vec::new();
+        for (id, (pts, q)) in [(&near, &p), (&far, &coarse)].into_iter().enumerate() {
+            let s = shape(DVec3::ZERO, pts, q, view, GroundRule::BelowViewpoint, false).unwrap();
+            assert!(s.kept.iter().all(|&k| k));
+            prims.push(Primitive {
+                id: id as u32,
+                ..s.primitive
+            });
+        }
+        assert!(prims[1].footprint.cell() > prims[0].footprint.cell());
+        let pts = [near.clone(), far.clone()].concat();
+        let mut labels: Vec<u32> = (0..pts.len()).map(|i| (i >= near.len()) as u32).collect();
+        merge_pieces(&mut prims, &mut labels, &pts, DVec3::ZERO, &p);
+        assert_eq!(prims.len(), 1);
+        assert!(labels.iter().all(|&l| l == 0));
+        assert_eq!(prims[0].support, pts.len() as u64);
+        // The near part (14 m x 2 m) and the far one (7 m x 1.8 m between
+        // its outer points), less the half-cell inset.
+        assert!(prims[0].area > 36.0, "{}", prims[0].area);
     }
 
     #[test]

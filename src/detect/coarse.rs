@@ -1,0 +1,203 @@
+//! The coarse pass ([`CascadePolicy::coarse_pass`]): a second cascade, at
+//! [`SCALE`] times the first one's clustering tolerance, footprint cell,
+//! outline radius and sampling voxel, on the points that no primitive
+//! explains and that lie too sparsely for the first one.
+//!
+//! A spinning LiDAR samples a surface ever more sparsely with range and
+//! with grazing incidence: a facade 60-100 m down the street, seen along
+//! its length, holds a few laser rings half a metre apart, with gaps of a
+//! metre along each. At the first pass's scale its points fall apart into
+//! fragments (the clustering breaks at every gap wider than its tolerance)
+//! and no round finds it. Only points whose neighbourhood is sparse take
+//! part: the leftovers of well-sampled surfaces (the laser-ring bands of a
+//! facade at a door's or a window's height) would, at this scale, join
+//! into horizontal slabs across the surfaces they lie on.
+//!
+//! [`CascadePolicy::coarse_pass`]: super::CascadePolicy::coarse_pass
+
+use super::{Detection, Detector, Progress, NO_PRIMITIVE};
+use crate::floor::GroundRule;
+use crate::hash::{voxelise, Buckets};
+use crate::params::Params;
+use crate::primitive::Primitive;
+use crate::rng::Rng;
+use glam::{DVec3, Vec3};
+use std::ops::ControlFlow;
+
+/// How much coarser the second pass is than the first: its clustering
+/// tolerance, footprint cell, outline radius and sampling voxel.
+pub(crate) const SCALE: f64 = 3.0;
+
+/// The stream the coarse pass's generator is derived with.
+pub(super) const STREAM: u64 = 0xC0A5;
+
+/// The 26 voxels around one.
+const NEIGHBOURS: [[i64; 3]; 26] = {
+    let mut out = [[0i64; 3]; 26];
+    let mut k = 0;
+    let mut i = 0;
+    while i < 27 {
+        if i != 13 {
+            out[k] = [i as i64 % 3 - 1, (i as i64 / 3) % 3 - 1, i as i64 / 9 - 1];
+            k += 1;
+        }
+        i += 1;
+    }
+    out
+};
+
+/// The parameters of the coarse pass: `p` at [`SCALE`] times its
+/// clustering tolerances, cells, outline radii and sampling voxel.
+fn coarser(p: &Params) -> Params {
+    let mut q = p.clone();
+    for s in [&mut q.other, &mut q.ground] {
+        s.cluster_tolerance *= SCALE;
+        s.cell *= SCALE;
+        s.alpha *= SCALE;
+    }
+    q.sample_radius *= SCALE;
+    q
+}
+
+/// The points that no primitive explains (`labels`) and that have no more
+/// neighbours in the whole cloud, within the clustering tolerance `r`,
+/// than a surface sampled at one point per footprint cell `c` would have
+/// (pi r^2 / c^2, rounded down: 19 with the defaults). Below that density the first
+/// pass's footprint has a hole in most cells, and its clustering breaks.
+fn sparse_leftovers(pts: &[Vec3], labels: &[u32], p: &Params) -> Vec<u32> {
+    let (r, c) = (p.other.cluster_tolerance, p.other.cell);
+    let most = (std::f64::consts::PI * (r / c) * (r / c)).floor();
+    if !(most.is_finite() && r > 0.0) {
+        return Vec::new();
+    }
+    // Counting stops past `most`, which bounds the work in dense places.
+    let most = most as usize;
+    let vox = voxelise(pts, r);
+    let buckets = Buckets::new(&vox.cell_of, vox.coords.len());
+    let r2 = (r * r) as f32;
+    let sparse = |i: usize| -> bool {
+        let c = vox.coords[vox.cell_of[i] as usize];
+        let q = pts[i];
+        let mut n = 0usize;
+        // Its own voxel first: where most neighbours are, so a dense point
+        // is told after a few comparisons.
+        for d in std::iter::once([0, 0, 0]).chain(NEIGHBOURS) {
+            let Some(id) = vox.ids.get([c[0] + d[0], c[1] + d[1], c[2] + d[2]]) else {
+                continue;
+            };
+            for &j in buckets.of(id as usize) {
+                if j as usize != i && (pts[j as usize] - q).length_squared() <= r2 {
+                    n += 1;
+                    if n > most {
+                        return false;
+                    }
+                }
+            }
+        }
+        true
+    };
+    (0..pts.len())
+        .filter(|&i| labels[i] == NO_PRIMITIVE && sparse(i))
+        .map(|i| i as u32)
+        .collect()
+}
+
+/// Run the coarse pass after `first`'s rounds and add what it finds to
+/// `out` (labels, primitives numbered on, steps, work); `progress` counts
+/// its rounds on from the first pass's. The flag: stopped by `progress`.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn pass(
+    first: &Detector,
+    out: &mut Detection,
+    pts: &[Vec3],
+    origin: DVec3,
+    viewpoint: DVec3,
+    ground: GroundRule,
+    rng: Rng,
+    progress: &mut dyn FnMut(&Progress) -> ControlFlow<()>,
+) -> bool {
+    let p = first.params;
+    let room = p.max_primitives.saturating_sub(out.primitives.len());
+    let budget = p.max_work.saturating_sub(out.work);
+    if room == 0 || budget == 0 {
+        return false;
+    }
+    let sparse = sparse_leftovers(pts, &out.labels, p);
+    if sparse.len() < p.min_inliers {
+        return false;
+    }
+    let sub: Vec<Vec3> = sparse.iter().map(|&i| pts[i as usize]).collect();
+    let q = Params {
+        max_primitives: room,
+        max_work: budget,
+        ..coarser(p)
+    };
+    let (rounds, found) = (out.steps.len(), out.primitives.len());
+    let (more, stopped) =
+        Detector::new(&q, first.policy).rounds(&sub, origin, viewpoint, ground, rng, &mut |at| {
+            progress(&Progress {
+                round: rounds + at.round,
+                points_left: at.points_left,
+                points: pts.len(),
+                primitives: found + at.primitives,
+            })
+        });
+    let base = found as u32;
+    for (&i, &l) in sparse.iter().zip(&more.labels) {
+        if l != NO_PRIMITIVE {
+            out.labels[i as usize] = base + l;
+        }
+    }
+    out.primitives
+        .extend(more.primitives.into_iter().map(|q| Primitive {
+            id: base + q.id,
+            ..q
+        }));
+    out.steps.extend(more.steps);
+    out.work += more.work;
+    stopped
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Points of the vertical patch y = `y`, x in `x0..x1`, z in 0..2, every
+    /// `step` metres.
+    fn grid(x0: f64, x1: f64, y: f64, step: f64) -> Vec<Vec3> {
+        let mut out = Vec::new();
+        let mut x = x0;
+        while x < x1 {
+            let mut z = 0.0;
+            while z < 2.0 {
+                out.push(Vec3::new(x as f32, y as f32, z as f32));
+                z += step;
+            }
+            x += step;
+        }
+        out
+    }
+
+    /// Only the leftovers of a sparsely seen surface take part: not those
+    /// of a dense one, nor a band of a dense surface a primitive explains
+    /// the rest of.
+    #[test]
+    fn the_coarse_pass_takes_the_sparse_leftovers_only() {
+        let p = Params::gpp2();
+        let sparse = grid(0.0, 10.0, 0.0, 0.5);
+        let dense = grid(20.0, 24.0, 0.0, 0.05);
+        let explained = grid(30.0, 34.0, 0.0, 0.05);
+        let pts = [sparse.clone(), dense.clone(), explained.clone()].concat();
+        let mut labels = vec![NO_PRIMITIVE; pts.len()];
+        let from = sparse.len() + dense.len();
+        // All of the third patch but the band between z = 1 and 1.2 m.
+        for (i, q) in pts.iter().enumerate().skip(from) {
+            if !(1.0..1.2).contains(&q.z) {
+                labels[i] = 0;
+            }
+        }
+        let left = sparse_leftovers(&pts, &labels, &p);
+        let want: Vec<u32> = (0..sparse.len() as u32).collect();
+        assert_eq!(left, want);
+    }
+}
