@@ -1,5 +1,6 @@
 //! One-shot detection (gpp1, gpp2) on a simulated HDL-64E street scan
-//! (~120k points), a simulated location (10 scans, ~1.2M points) and the
+//! (~120k points), a simulated location (10 scans, ~1.2M points; from its
+//! mean pose, and seen from nowhere) and the
 //! real Ouster scans bundled in www/data. One thread.
 //! `cargo bench --bench detect`
 
@@ -43,6 +44,15 @@ fn bench(c: &mut Criterion) {
         };
         g.bench_function(
             format!("{name}/sim-location-{}k", loc_cloud.len() / 1000),
+            |b| b.iter(|| black_box(detect(&loc_cloud, &p).unwrap().primitives.len())),
+        );
+        // Seen from nowhere, as a map is: the coarse pass runs.
+        let p = preset.clone();
+        g.bench_function(
+            format!(
+                "{name}/sim-location-{}k-no-viewpoint",
+                loc_cloud.len() / 1000
+            ),
             |b| b.iter(|| black_box(detect(&loc_cloud, &p).unwrap().primitives.len())),
         );
         for file in [

@@ -27,8 +27,10 @@ options! {
     /// edge-on: laser rings) is dropped unless it reaches within 1 m of it.
     /// Ground is decided from the cloud's local floor either way. Default
     /// null: the origin when a sensor could have stood there (a scan in its
-    /// own frame), else none (a map: no rules that need a viewpoint). The
-    /// scenario uses each scan's pose instead.
+    /// own frame), else none (a map: no rules that need a viewpoint, and a
+    /// second pass at three times the scale finds the surfaces the map
+    /// holds too sparsely for the first). The scenario uses each scan's
+    /// pose instead.
     viewpoint: Option<[f64; 3]> = viewpoint, "m", Check::FiniteOrNull;
     /// Fewest inliers a plane needs, and fewest support points a primitive
     /// needs; the cascade stops when the best plane has fewer. gpp2 default
