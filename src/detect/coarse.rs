@@ -27,29 +27,22 @@ use std::ops::ControlFlow;
 /// How much coarser the second pass is than the first: its clustering
 /// tolerance, footprint cell, outline radius and sampling voxel.
 pub(crate) const SCALE: f64 = 3.0;
+/// [`SCALE`], as an integer.
+const SCALE_INT: usize = 3;
 
 /// The stream the coarse pass's generator is derived with.
 pub(super) const STREAM: u64 = 0xC0A5;
 
-/// The 26 voxels around one.
-const NEIGHBOURS: [[i64; 3]; 26] = {
-    let mut out = [[0i64; 3]; 26];
-    let mut k = 0;
-    let mut i = 0;
-    while i < 27 {
-        if i != 13 {
-            out[k] = [i as i64 % 3 - 1, (i as i64 / 3) % 3 - 1, i as i64 / 9 - 1];
-            k += 1;
-        }
-        i += 1;
-    }
-    out
-};
-
 /// The parameters of the coarse pass: `p` at [`SCALE`] times its
-/// clustering tolerances, cells, outline radii and sampling voxel.
+/// clustering tolerances, cells, outline radii and sampling voxel, and
+/// `minInliers` over [`SCALE`] (50 with the defaults): a surface seen at
+/// grazing incidence is sampled more sparsely along it, and the first
+/// pass's count would ask a far facade for the support of one seen face
+/// on. (Over `SCALE^2`, for sampling sparser both ways, found more on the
+/// own simulator's locations but at precision 0.877 against 0.950.)
 fn coarser(p: &Params) -> Params {
     let mut q = p.clone();
+    q.min_inliers = p.min_inliers.div_ceil(SCALE_INT);
     for s in [&mut q.other, &mut q.ground] {
         s.cluster_tolerance *= SCALE;
         s.cell *= SCALE;
@@ -66,12 +59,9 @@ fn coarser(p: &Params) -> Params {
 /// pass's footprint has a hole in most cells, and its clustering breaks.
 fn sparse_leftovers(pts: &[Vec3], labels: &[u32], p: &Params) -> Vec<u32> {
     let (r, c) = (p.other.cluster_tolerance, p.other.cell);
-    let most = (std::f64::consts::PI * (r / c) * (r / c)).floor();
-    if !(most.is_finite() && r > 0.0) {
-        return Vec::new();
-    }
     // Counting stops past `most`, which bounds the work in dense places.
-    let most = most as usize;
+    // (Validated parameters: `r` in (0, 1000], `c` at least 0.01 m.)
+    let most = (std::f64::consts::PI * (r / c) * (r / c)) as usize;
     let vox = voxelise(pts, r);
     let buckets = Buckets::new(&vox.cell_of, vox.coords.len());
     let r2 = (r * r) as f32;
@@ -79,10 +69,13 @@ fn sparse_leftovers(pts: &[Vec3], labels: &[u32], p: &Params) -> Vec<u32> {
         let c = vox.coords[vox.cell_of[i] as usize];
         let q = pts[i];
         let mut n = 0usize;
-        // Its own voxel first: where most neighbours are, so a dense point
+        // The 27 voxels of the block around its own, its own first (the
+        // block's centre, 13): most neighbours are there, so a dense point
         // is told after a few comparisons.
-        for d in std::iter::once([0, 0, 0]).chain(NEIGHBOURS) {
-            let Some(id) = vox.ids.get([c[0] + d[0], c[1] + d[1], c[2] + d[2]]) else {
+        for k in 0..27 {
+            let d = (k + 13) % 27;
+            let v = [c[0] + d % 3 - 1, c[1] + d / 3 % 3 - 1, c[2] + d / 9 - 1];
+            let Some(id) = vox.ids.get(v) else {
                 continue;
             };
             for &j in buckets.of(id as usize) {
@@ -118,20 +111,19 @@ pub(super) fn pass(
 ) -> bool {
     let p = first.params;
     let room = p.max_primitives.saturating_sub(out.primitives.len());
-    let budget = p.max_work.saturating_sub(out.work);
-    if room == 0 || budget == 0 {
+    if room == 0 {
         return false;
     }
+    let q = Params {
+        max_primitives: room,
+        max_work: p.max_work.saturating_sub(out.work),
+        ..coarser(p)
+    };
     let sparse = sparse_leftovers(pts, &out.labels, p);
-    if sparse.len() < p.min_inliers {
+    if sparse.len() < q.min_inliers {
         return false;
     }
     let sub: Vec<Vec3> = sparse.iter().map(|&i| pts[i as usize]).collect();
-    let q = Params {
-        max_primitives: room,
-        max_work: budget,
-        ..coarser(p)
-    };
     let (rounds, found) = (out.steps.len(), out.primitives.len());
     let (more, stopped) =
         Detector::new(&q, first.policy).rounds(&sub, origin, viewpoint, ground, rng, &mut |at| {

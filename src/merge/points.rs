@@ -161,10 +161,10 @@ fn absorb(
     let (mut total, mut bad) = (vec![0usize; n], vec![0usize; n]);
     // In increasing order, as the labels hold them: the moments removed
     // below sum in that order.
-    let mut pieces: Vec<u32> = group
-        .iter()
-        .flat_map(|&j| members[j].iter().copied())
-        .collect();
+    let mut pieces: Vec<u32> = Vec::new();
+    for &j in group {
+        pieces.extend_from_slice(&members[j]);
+    }
     pieces.sort_unstable();
     for i in pieces.into_iter().map(|i| i as usize) {
         let (l, w) = (labels[i] as usize, world(i));
@@ -174,24 +174,23 @@ fn absorb(
         taken.push((i, on.then(|| out.frame.to_local(w))));
     }
     let mut marks: Vec<DVec2> = taken.iter().filter_map(|t| t.1).collect();
-    // A piece traced on coarser cells (one-shot detection's coarse pass)
-    // marks its cells whole: its points alone, on `big`'s finer cells,
-    // would leave the holes its outline closed.
+    // A piece traced on coarser cells than the parameters' (one-shot
+    // detection's coarse pass) marks its cells whole: its points alone, on
+    // `big`'s cells (finer, or as coarse on another grid), would leave the
+    // holes its outline closed. Each of its cells is sampled n x n, no
+    // farther apart than half of `big`'s cell.
     let fine = out.footprint.cell();
     for &j in group {
         let piece = &primitives[j];
         let coarse = piece.footprint.cell();
-        if coarse > fine {
-            let n = (coarse / fine).ceil() as usize;
-            let offsets: Vec<f64> = (0..n)
-                .map(|k| ((k as f64 + 0.5) / n as f64 - 0.5) * coarse)
-                .collect();
+        if coarse > p.surface(piece.ground).cell {
+            let n = (coarse / fine).ceil() as usize + 1;
+            let step = coarse / n as f64;
             for c in piece.footprint.cell_centres() {
-                for &dx in &offsets {
-                    for &dy in &offsets {
-                        let w = piece.frame.to_world(c + DVec2::new(dx, dy));
-                        marks.push(out.frame.to_local(w));
-                    }
+                let corner = c - DVec2::splat(0.5 * (coarse - step));
+                for k in 0..n * n {
+                    let at = corner + DVec2::new((k % n) as f64, (k / n) as f64) * step;
+                    marks.push(out.frame.to_local(piece.frame.to_world(at)));
                 }
             }
         }
@@ -239,31 +238,25 @@ fn absorb(
     out.outline = ring;
     out.footprint.retain_region(&region);
     let mut gone = Moments::new(out.moments.reference);
+    for &i in &own_out {
+        labels[i] = NO_PRIMITIVE;
+    }
+    let mut now = std::mem::take(&mut members[big]);
+    now.retain(|&i| labels[i as usize] == big as u32);
     for (&(i, _), &stay) in taken.iter().zip(&kept) {
         if stay {
             labels[i] = big as u32;
             out.support += 1;
+            now.push(i as u32);
         } else {
             labels[i] = NO_PRIMITIVE;
             gone.push(world(i));
         }
     }
     for &i in &own_out {
-        labels[i] = NO_PRIMITIVE;
         gone.push(world(i));
     }
     out.support = out.support.saturating_sub(own_out.len() as u64);
-    let mut now: Vec<u32> = taken
-        .iter()
-        .zip(&kept)
-        .filter_map(|(&(i, _), &stay)| stay.then_some(i as u32))
-        .chain(
-            members[big]
-                .iter()
-                .copied()
-                .filter(|&i| labels[i as usize] == big as u32),
-        )
-        .collect();
     now.sort_unstable();
     members[big] = now;
     for &j in group {
