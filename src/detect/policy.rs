@@ -100,7 +100,7 @@ pub struct CascadePolicy {
     pub find_risers: bool,
     /// After the rounds, a second cascade at three times the scale
     /// (clustering tolerance, footprint cell, outline radius, sampling
-    /// voxel) runs on the points no primitive explains whose neighbourhood
+    /// voxel), with a third of `minInliers`, runs on the points no primitive explains whose neighbourhood
     /// is sparser than one point per footprint cell (the `coarse` module):
     /// far facades seen along a street, a plateau's top seen from below
     /// its edge. Its primitives keep their coarser footprint and merge
