@@ -4,7 +4,7 @@
 //! explains and that lie too sparsely for the first one.
 //!
 //! A spinning LiDAR samples a surface ever more sparsely with range and
-//! with grazing incidence: a facade 60-100 m down the street, seen along
+//! with grazing incidence: a facade 40-100 m down the street, seen along
 //! its length, holds a few laser rings half a metre apart, with gaps of a
 //! metre along each. At the first pass's scale its points fall apart into
 //! fragments (the clustering breaks at every gap wider than its tolerance)
@@ -55,8 +55,9 @@ fn coarser(p: &Params) -> Params {
 /// The points that no primitive explains (`labels`) and that have no more
 /// neighbours in the whole cloud, within the clustering tolerance `r`,
 /// than a surface sampled at one point per footprint cell `c` would have
-/// (pi r^2 / c^2, rounded down: 19 with the defaults). Below that density the first
-/// pass's footprint has a hole in most cells, and its clustering breaks.
+/// (pi r^2 / c^2, rounded down: 19 with the defaults). Below that density
+/// the first pass's footprint has a hole in most cells, and its clustering
+/// breaks.
 fn sparse_leftovers(pts: &[Vec3], labels: &[u32], p: &Params) -> Vec<u32> {
     let (r, c) = (p.other.cluster_tolerance, p.other.cell);
     // Counting stops past `most`, which bounds the work in dense places.

@@ -49,7 +49,8 @@ const SCATTERED_MIN_POINTS: usize = 8;
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 #[serde(rename_all = "camelCase")]
 pub struct CascadeStep {
-    /// Points still in play before this round.
+    /// Points still in play before this round (in the coarse pass's
+    /// rounds, of that pass's points).
     pub points_left: usize,
     /// RANSAC inliers of the round's best plane.
     pub inliers: usize,
@@ -199,7 +200,11 @@ pub struct Progress {
     /// Rounds done (each finds the plane of largest consensus among the
     /// points left and takes out its accepted or rejected patches).
     pub round: usize,
-    /// Points not yet taken out (explained or discarded).
+    /// Points not yet taken out (explained or discarded). In the coarse
+    /// pass of a cloud seen from nowhere
+    /// ([`CascadePolicy::coarse_pass`]), the points of that pass not yet
+    /// taken out: it starts again from the sparse unexplained points, which
+    /// can be more than the first pass left in play.
     pub points_left: usize,
     /// Points of the cloud.
     pub points: usize,

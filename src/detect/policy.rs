@@ -100,8 +100,9 @@ pub struct CascadePolicy {
     pub find_risers: bool,
     /// After the rounds, a second cascade at three times the scale
     /// (clustering tolerance, footprint cell, outline radius, sampling
-    /// voxel), with a third of `minInliers`, runs on the points no primitive explains whose neighbourhood
-    /// is sparser than one point per footprint cell (the `coarse` module):
+    /// voxel), with a third of `minInliers`, runs on the points no
+    /// primitive explains whose neighbourhood is sparser than one point
+    /// per footprint cell (the `coarse` module):
     /// far facades seen along a street, a plateau's top seen from below
     /// its edge. Its primitives keep their coarser footprint and merge
     /// with the first pass's pieces of the same surface. Only for a cloud
@@ -178,8 +179,8 @@ impl CascadePolicy {
     /// the undersides of the independent bench's tree crowns (crossing
     /// precision 0.989 -> 0.957; BENCHMARKS.md). No coarse pass: it found
     /// most far cars of the bench's crossing drives but joined rows of
-    /// parked cars with their curb into planes (precision 1.000 -> 0.913). Ground is judged from
-    /// the scan's pose. Risers are not found here: the scenario finds them
+    /// parked cars with their curb into planes (precision 1.000 -> 0.913).
+    /// Ground is judged from the scan's pose. Risers are not found here: the scenario finds them
     /// after this detection, between the primitives the scan reached and
     /// from all of the scan's points (a curb's face is mostly explained by
     /// the road's and the sidewalk's expansion, never a leftover).

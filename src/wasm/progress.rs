@@ -14,7 +14,9 @@ use wasm_bindgen::prelude::*;
 
 /// [`detect`](super::detect) that calls `onProgress({ round, pointsLeft,
 /// points, polygons })` after each round of the cascade (`pointsLeft` falls
-/// towards 0; the rounds' count is not known in advance). `onProgress`
+/// towards 0, then, for a cloud seen from nowhere, once more from the
+/// sparse points its coarse pass takes up; the rounds' count is not known
+/// in advance). `onProgress`
 /// returning `false` stops the detection there: it then throws an `Error`
 /// saying so. An exception thrown by `onProgress` ends the detection: the
 /// `Error` thrown then has it as `cause`. A detection that runs to its end gives what `detect`
@@ -84,7 +86,7 @@ const DETECT_PROGRESS_TS: &str = r#"
 export interface DetectProgress {
     /** Rounds done. */
     round: number;
-    /** Points not yet explained or discarded: falls towards 0. */
+    /** Points not yet explained or discarded: falls towards 0 (for a cloud seen from nowhere, a second time in its coarse pass, from the sparse points it takes up). */
     pointsLeft: number;
     /** Points of the cloud. */
     points: number;

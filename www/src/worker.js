@@ -43,7 +43,8 @@
 //        loaded, then each runs to its end)
 //   { type: 'progress', request, stage: 'round', points, round, pointsLeft, polygons }
 //        after a round of the detection cascade (the first, then at most one
-//        per PROGRESS_MS); pointsLeft falls towards 0
+//        per PROGRESS_MS); pointsLeft falls towards 0 (a second time in the
+//        coarse pass of a cloud seen from nowhere)
 //   { type: 'result', request, polygons?, error?, ms }
 //        the request's answer: polygons (vertices transferred), or an error
 //        message
