@@ -15,13 +15,12 @@
 //!
 //! [`CascadePolicy::coarse_pass`]: super::CascadePolicy::coarse_pass
 
-use super::{Detection, Detector, Progress, NO_PRIMITIVE};
-use crate::floor::GroundRule;
+use super::{Detection, Detector, Progress, Seen, NO_PRIMITIVE};
 use crate::hash::{voxelise, Buckets};
 use crate::params::Params;
 use crate::primitive::Primitive;
 use crate::rng::Rng;
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 use std::ops::ControlFlow;
 
 /// How much coarser the second pass is than the first: its clustering
@@ -99,17 +98,14 @@ fn sparse_leftovers(pts: &[Vec3], labels: &[u32], p: &Params) -> Vec<u32> {
 /// Run the coarse pass after `first`'s rounds and add what it finds to
 /// `out` (labels, primitives numbered on, steps, work); `progress` counts
 /// its rounds on from the first pass's. The flag: stopped by `progress`.
-#[allow(clippy::too_many_arguments)]
 pub(super) fn pass(
     first: &Detector,
     out: &mut Detection,
-    pts: &[Vec3],
-    origin: DVec3,
-    viewpoint: DVec3,
-    ground: GroundRule,
+    seen: Seen,
     rng: Rng,
     progress: &mut dyn FnMut(&Progress) -> ControlFlow<()>,
 ) -> bool {
+    let pts = seen.pts;
     let p = first.params;
     let room = p.max_primitives.saturating_sub(out.primitives.len());
     if room == 0 {
@@ -124,17 +120,20 @@ pub(super) fn pass(
     if sparse.len() < q.min_inliers {
         return false;
     }
-    let sub: Vec<Vec3> = sparse.iter().map(|&i| pts[i as usize]).collect();
+    let points: Vec<Vec3> = sparse.iter().map(|&i| pts[i as usize]).collect();
     let (rounds, found) = (out.steps.len(), out.primitives.len());
-    let (more, stopped) =
-        Detector::new(&q, first.policy).rounds(&sub, origin, viewpoint, ground, rng, &mut |at| {
-            progress(&Progress {
-                round: rounds + at.round,
-                points_left: at.points_left,
-                points: pts.len(),
-                primitives: found + at.primitives,
-            })
-        });
+    let sub = Seen {
+        pts: &points,
+        ..seen
+    };
+    let (more, stopped) = Detector::new(&q, first.policy).rounds(sub, rng, &mut |at| {
+        progress(&Progress {
+            round: rounds + at.round,
+            points_left: at.points_left,
+            points: pts.len(),
+            primitives: found + at.primitives,
+        })
+    });
     let base = found as u32;
     for (&i, &l) in sparse.iter().zip(&more.labels) {
         if l != NO_PRIMITIVE {

@@ -212,6 +212,16 @@ pub struct Progress {
     pub primitives: usize,
 }
 
+/// A cloud as one pass of the cascade sees it: points local to `origin`,
+/// the sensor (world), and what tells ground.
+#[derive(Clone, Copy)]
+struct Seen<'a> {
+    pts: &'a [Vec3],
+    origin: DVec3,
+    viewpoint: DVec3,
+    ground: GroundRule<'a>,
+}
+
 /// The detection cascade: parameters (validated by the caller) and the
 /// rule set.
 pub struct Detector<'p> {
@@ -266,16 +276,18 @@ impl<'p> Detector<'p> {
         // The coarse pass's generator, derived from the cascade's first
         // draw: an explicit generator fixes both.
         let coarse_rng = Rng::derive(rng.clone().next_u64(), coarse::STREAM);
-        let (mut out, stopped) = self.rounds(pts, origin, viewpoint, ground, rng, progress);
+        let seen = Seen {
+            pts,
+            origin,
+            viewpoint,
+            ground,
+        };
+        let (mut out, stopped) = self.rounds(seen, rng, progress);
         if stopped {
             return (out, true);
         }
         // 7. A coarser cascade on the points too sparse for this one.
-        if policy.coarse_pass
-            && coarse::pass(
-                self, &mut out, pts, origin, viewpoint, ground, coarse_rng, progress,
-            )
-        {
+        if policy.coarse_pass && coarse::pass(self, &mut out, seen, coarse_rng, progress) {
             return (out, true);
         }
         // 8. Merge the pieces of one surface that rounds or passes found
@@ -308,13 +320,16 @@ impl<'p> Detector<'p> {
     /// with `progress` called after each; the flag: stopped by `progress`.
     fn rounds(
         &self,
-        pts: &[Vec3],
-        origin: DVec3,
-        viewpoint: DVec3,
-        ground: GroundRule,
+        seen: Seen,
         rng: Rng,
         progress: &mut dyn FnMut(&Progress) -> ControlFlow<()>,
     ) -> (Detection, bool) {
+        let Seen {
+            pts,
+            origin,
+            viewpoint,
+            ground,
+        } = seen;
         let (p, policy) = (self.params, &self.policy);
         let t0 = clock::now_ms();
         let local_viewpoint = viewpoint - origin;
