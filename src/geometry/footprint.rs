@@ -557,6 +557,26 @@ impl Footprint {
         let pts: Vec<DVec2> = other.cell_centres().into_iter().map(map).collect();
         let _ = self.mark_all(&pts);
     }
+
+    /// Points that cover this footprint's set cells whole for a footprint
+    /// of cell `cell` (finer, or as fine on another grid), each mapped
+    /// through `map`: n x n a cell, no farther apart than half of `cell`.
+    /// [`Footprint::merge_mapped`]'s cell centres alone would leave holes
+    /// in a finer raster.
+    pub fn covering_points(&self, cell: f64, map: impl Fn(DVec2) -> DVec2) -> Vec<DVec2> {
+        let n = (self.cell / cell).ceil() as usize + 1;
+        let step = self.cell / n as f64;
+        let mut out = Vec::new();
+        for c in self.cell_centres() {
+            let corner = c - DVec2::splat(0.5 * (self.cell - step));
+            for k in 0..n * n {
+                out.push(map(
+                    corner + DVec2::new((k % n) as f64, (k / n) as f64) * step
+                ));
+            }
+        }
+        out
+    }
 }
 
 /// The raster region a concave outline was traced from (before

@@ -177,22 +177,13 @@ fn absorb(
     // A piece traced on coarser cells than the parameters' (one-shot
     // detection's coarse pass) marks its cells whole: its points alone, on
     // `big`'s cells (finer, or as coarse on another grid), would leave the
-    // holes its outline closed. Each of its cells is sampled n x n, no
-    // farther apart than half of `big`'s cell.
-    let fine = out.footprint.cell();
+    // holes its outline closed.
     for &j in group {
         let piece = &primitives[j];
-        let coarse = piece.footprint.cell();
-        if coarse > p.surface(piece.ground).cell {
-            let n = (coarse / fine).ceil() as usize + 1;
-            let step = coarse / n as f64;
-            for c in piece.footprint.cell_centres() {
-                let corner = c - DVec2::splat(0.5 * (coarse - step));
-                for k in 0..n * n {
-                    let at = corner + DVec2::new((k % n) as f64, (k / n) as f64) * step;
-                    marks.push(out.frame.to_local(piece.frame.to_world(at)));
-                }
-            }
+        if piece.footprint.cell() > p.surface(piece.ground).cell {
+            marks.extend(piece.footprint.covering_points(out.footprint.cell(), |q| {
+                out.frame.to_local(piece.frame.to_world(q))
+            }));
         }
     }
     out.footprint.mark_all(&marks);
