@@ -83,9 +83,7 @@ pub fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
     if !close && !layered {
         return false;
     }
-    let ((alo, ahi), (blo, bhi)) = (bounds(&av), bounds(&bv));
-    let pad = DVec3::splat(params.merge_box_pad());
-    if (alo - pad).cmpgt(bhi).any() || (blo - pad).cmpgt(ahi).any() {
+    if boxes_apart(bounds(&av), bounds(&bv), params) {
         return false;
     }
     if layered {
@@ -99,6 +97,15 @@ pub fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
     // The outlines, both in a's frame: touching or overlapping?
     let b_in_a: Vec<DVec2> = bv.iter().map(|&v| a.frame.to_local(v)).collect();
     rings_within(&a.outline, &b_in_a, params.merge_gap)
+}
+
+/// Are two outlines' bounding boxes (world, from their vertices) farther
+/// apart than any [`mergeable`] pair can be? A cheap test first: a pass
+/// over many pieces rejects most pairs with it, before the vertices of
+/// both outlines are computed.
+pub(crate) fn boxes_apart(a: (DVec3, DVec3), b: (DVec3, DVec3), params: &Params) -> bool {
+    let pad = DVec3::splat(params.merge_box_pad());
+    (a.0 - pad).cmpgt(b.1).any() || (b.0 - pad).cmpgt(a.1).any()
 }
 
 /// Does most of `small`'s support lie where `big` has support too? At

@@ -2,7 +2,8 @@
 //! the pieces it found. Labels follow the merges, and a merge that would
 //! leave support off its plane or outside its outline is not made.
 
-use super::mergeable;
+use super::{boxes_apart, mergeable};
+use crate::geometry::bounds;
 use crate::geometry::plane::Moments;
 use crate::geometry::polygon::signed_area;
 use crate::params::Params;
@@ -45,6 +46,9 @@ pub(crate) fn merge_pieces(
             members[l as usize].push(i as u32);
         }
     }
+    // Each primitive's outline box, kept up to date as it grows: most
+    // pairs are told apart by it alone.
+    let mut boxes: Vec<(DVec3, DVec3)> = primitives.iter().map(|q| bounds(&q.vertices())).collect();
     let mut into: Vec<u32> = (0..n as u32).collect();
     let mut grown = vec![true; n];
     for _ in 0..n {
@@ -57,6 +61,7 @@ pub(crate) fn merge_pieces(
                 .filter(|&j| {
                     into[j] == j as u32
                         && (grown[first] || grown[j])
+                        && !boxes_apart(boxes[first], boxes[j], p)
                         && mergeable(&primitives[first], &primitives[j], p)
                 })
                 .collect();
@@ -86,6 +91,7 @@ pub(crate) fn merge_pieces(
                     p,
                 ) {
                     Ok(out) => {
+                        boxes[big] = bounds(&out.vertices());
                         primitives[big] = out;
                         for &j in &group {
                             into[j] = big as u32;
