@@ -5,7 +5,7 @@
 use super::{boxes_apart, mergeable};
 use crate::geometry::bounds;
 use crate::geometry::plane::Moments;
-use crate::geometry::polygon::signed_area;
+use crate::geometry::polygon::{contains, signed_area};
 use crate::params::Params;
 use crate::primitive::{Primitive, NO_PRIMITIVE};
 use glam::{DVec2, DVec3, Vec3};
@@ -25,7 +25,8 @@ use glam::{DVec2, DVec3, Vec3};
 /// stays apart, and the others merge without it. A merged outline is larger and can touch a
 /// piece it did not touch before, so passes repeat until nothing merges;
 /// after the first, only groups with a primitive grown in the last pass
-/// are looked at.
+/// are looked at. Last, the recesses a larger survivor's outline spans are
+/// dropped ([`drop_covered`]).
 #[inline(never)]
 pub(crate) fn merge_pieces(
     primitives: &mut Vec<Primitive>,
@@ -109,6 +110,7 @@ pub(crate) fn merge_pieces(
         }
         grown = next;
     }
+    drop_covered(primitives, &mut into, &boxes, p);
     // Survivors in their order, numbered densely; labels follow.
     let mut dense = vec![NO_PRIMITIVE; n];
     let mut k = 0;
@@ -132,6 +134,53 @@ pub(crate) fn merge_pieces(
     for l in labels.iter_mut() {
         if *l != NO_PRIMITIVE {
             *l = dense[*l as usize];
+        }
+    }
+}
+
+/// Drop the survivors of the merge (`into[i] == i`) that are recesses in
+/// a larger survivor: wholly within its outline, near-parallel to it
+/// (`mergeAngle`), behind its plane (on average, against its normal:
+/// below a near-horizontal one, away from the viewpoint for the others)
+/// and closer to it than two planes RANSAC can tell apart (the RMS
+/// distance of their outline vertices within `Params::layer_distance`).
+/// The merge keeps them apart because the larger one has no support where
+/// they lie: a tree pit's soil 10 cm below the sidewalk around it, a door
+/// set into a facade. Outlines have no holes, so the larger one's outline
+/// spans the recess, and the two would draw one place twice, a few
+/// centimetres apart; the larger one already draws it within that
+/// distance, in front. The piece is dropped (`into` set past every index)
+/// and its points lose their label. A piece in front (a traffic island
+/// above the road around it, a sign on a wall) stays: it would be hidden
+/// behind nothing. `boxes`: each primitive's outline box.
+fn drop_covered(primitives: &[Primitive], into: &mut [u32], boxes: &[(DVec3, DVec3)], p: &Params) {
+    let n = primitives.len();
+    let max_angle = p.merge_angle.to_radians();
+    for s in 0..n {
+        if into[s] != s as u32 {
+            continue;
+        }
+        let small = &primitives[s];
+        let vs = small.vertices();
+        let covered = (0..n).any(|b| {
+            let big = &primitives[b];
+            b != s
+                && into[b] == b as u32
+                && big.area > small.area
+                && !boxes_apart(boxes[s], boxes[b], p)
+                && big.plane.angle_to(&small.plane) <= max_angle
+                && {
+                    let d: Vec<f64> = vs.iter().map(|&v| big.plane.signed_distance(v)).collect();
+                    let k = d.len().max(1) as f64;
+                    let ms = d.iter().map(|d| d * d).sum::<f64>() / k;
+                    d.iter().sum::<f64>() < 0.0 && ms.sqrt() <= p.layer_distance()
+                }
+                && vs
+                    .iter()
+                    .all(|&v| contains(&big.outline, big.frame.to_local(v)))
+        });
+        if covered {
+            into[s] = u32::MAX;
         }
     }
 }
@@ -347,6 +396,39 @@ mod tests {
         // The near part (14 m x 2 m) and the far one (7 m x 1.8 m between
         // its outer points), less the half-cell inset.
         assert!(prims[0].area > 36.0, "{}", prims[0].area);
+    }
+
+    /// A door set 15 cm into a facade (away from the viewpoint at y = -6):
+    /// the facade has no points where the door is, so the two are not
+    /// merged, but the facade's outline (no holes) spans the door. The
+    /// door's piece is dropped and its points lose their label; the facade
+    /// is unchanged. A panel 15 cm in front of the facade stays.
+    #[test]
+    fn a_recess_the_larger_outline_spans_is_dropped() {
+        let p = Params::gpp2();
+        let in_door = |v: &Vec3| v.x > 3.0 && v.x < 4.5 && v.z > 0.2 && v.z < 1.8;
+        let wall: Vec<Vec3> = patch(0.0, 8.0, 0.0, 0.0)
+            .into_iter()
+            .filter(|v| !in_door(v))
+            .collect();
+        for (depth, kept) in [(0.15, 1), (-0.15, 2)] {
+            let door: Vec<Vec3> = patch(3.0, 4.5, 0.0, 0.025)
+                .into_iter()
+                .filter(in_door)
+                .map(|v| v + Vec3::new(0.0, depth, 0.0))
+                .collect();
+            let (mut prims, mut labels, pts) = two(&wall, &door, &p);
+            assert!(prims[0].plane.normal.y < 0.0);
+            assert!(!mergeable(&prims[0], &prims[1], &p));
+            let before = prims.clone();
+            merge_pieces(&mut prims, &mut labels, &pts, DVec3::ZERO, &p);
+            assert_eq!(prims.len(), kept, "door at {depth} m");
+            assert_eq!(prims[0].area, before[0].area);
+            assert_eq!(prims[0].support, wall.len() as u64);
+            assert!(labels[..wall.len()].iter().all(|&l| l == 0));
+            let door_label = if kept == 1 { NO_PRIMITIVE } else { 1 };
+            assert!(labels[wall.len()..].iter().all(|&l| l == door_label));
+        }
     }
 
     #[test]
