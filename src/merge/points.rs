@@ -49,7 +49,7 @@ pub(crate) fn merge_pieces(
     }
     // Each primitive's outline box, kept up to date as it grows: most
     // pairs are told apart by it alone.
-    let mut boxes: Vec<(DVec3, DVec3)> = primitives.iter().map(|q| bounds(&q.vertices())).collect();
+    let mut boxes: Vec<(DVec3, DVec3)> = primitives.iter().map(outline_box).collect();
     let mut into: Vec<u32> = (0..n as u32).collect();
     let mut grown = vec![true; n];
     for _ in 0..n {
@@ -92,7 +92,7 @@ pub(crate) fn merge_pieces(
                     p,
                 ) {
                     Ok(out) => {
-                        boxes[big] = bounds(&out.vertices());
+                        boxes[big] = outline_box(&out);
                         primitives[big] = out;
                         for &j in &group {
                             into[j] = big as u32;
@@ -138,6 +138,14 @@ pub(crate) fn merge_pieces(
     }
 }
 
+/// The world box of a primitive's outline vertices. Not inlined: each of
+/// its two call sites would carry a copy of the vertex code (0.3 kB of the
+/// gzipped wasm).
+#[inline(never)]
+fn outline_box(q: &Primitive) -> (DVec3, DVec3) {
+    bounds(&q.vertices())
+}
+
 /// Drop the survivors of the merge (`into[i] == i`) that are recesses in
 /// a larger survivor: wholly within its outline, near-parallel to it
 /// (`mergeAngle`), behind its plane (on average, against its normal:
@@ -170,10 +178,11 @@ fn drop_covered(primitives: &[Primitive], into: &mut [u32], boxes: &[(DVec3, DVe
                 && !boxes_apart(boxes[s], boxes[b], p)
                 && big.plane.angle_to(&small.plane) <= max_angle
                 && {
-                    let d: Vec<f64> = vs.iter().map(|&v| big.plane.signed_distance(v)).collect();
-                    let k = d.len().max(1) as f64;
-                    let ms = d.iter().map(|d| d * d).sum::<f64>() / k;
-                    d.iter().sum::<f64>() < 0.0 && ms.sqrt() <= p.layer_distance()
+                    let (sum, sq) = vs.iter().fold((0.0, 0.0), |(s, q), &v| {
+                        let d = big.plane.signed_distance(v);
+                        (s + d, q + d * d)
+                    });
+                    sum < 0.0 && sq <= p.layer_distance().powi(2) * vs.len() as f64
                 }
                 && vs
                     .iter()
