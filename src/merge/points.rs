@@ -159,8 +159,8 @@ fn outline_box(q: &Primitive) -> (DVec3, DVec3) {
 /// centimetres apart; the larger one already draws it within that
 /// distance, in front. The piece is dropped (`into` set past every index)
 /// and its points lose their label. A piece in front (a traffic island
-/// above the road around it, a sign on a wall) stays: it would be hidden
-/// behind nothing. `boxes`: each primitive's outline box.
+/// above the road around it, a sign on a wall) stays: the larger polygon,
+/// behind it, does not stand in for it. `boxes`: each outline's box.
 fn drop_covered(primitives: &[Primitive], into: &mut [u32], boxes: &[(DVec3, DVec3)], p: &Params) {
     let n = primitives.len();
     let max_angle = p.merge_angle.to_radians();
