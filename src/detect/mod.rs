@@ -310,6 +310,10 @@ impl<'p> Detector<'p> {
                 origin,
                 viewpoint,
                 p,
+                riser::Spacing {
+                    foot: policy.range_pulled_ground.then(|| viewpoint.truncate()),
+                    range: p.ground_cluster_range,
+                },
             );
         }
         out.time_ms = clock::now_ms() - t0;

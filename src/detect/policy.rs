@@ -28,7 +28,8 @@ pub struct CascadePolicy {
     /// Hypotheses scored per round: `maxHypotheses` times this.
     pub hypothesis_scale: usize,
     /// The ground's clustering tolerance grows with range beyond
-    /// `groundClusterRange`, as the gaps between laser rings do.
+    /// `groundClusterRange`, as the gaps between laser rings do; so do the
+    /// gaps a riser's evidence may leave (`riser::Spacing`).
     pub range_pulled_ground: bool,
     /// Ground footprints fill the gaps between laser rings that the
     /// range-pulled clustering bridged, so the outline follows every ring
@@ -183,7 +184,8 @@ impl CascadePolicy {
     /// Ground is judged from the scan's pose. Risers are not found here: the scenario finds them
     /// after this detection, between the primitives the scan reached and
     /// from all of the scan's points (a curb's face is mostly explained by
-    /// the road's and the sidewalk's expansion, never a leftover).
+    /// the road's and the sidewalk's expansion, never a leftover), with the
+    /// evidence spacing of the scan's sensor (`riser::Spacing`).
     pub const fn scenario_leftovers() -> Self {
         CascadePolicy {
             skip_edge_on_hypotheses: false,

@@ -28,10 +28,15 @@
 //!    `2 * alpha` merge, across pairs of surfaces (a curb runs past several
 //!    pieces of road).
 //! 4. A face is cut where its points leave a gap wider than `2 * alpha`;
-//!    a piece is kept when its points fill at least `minOccupancy` of its
-//!    length (in `cell` bins) and its area (length times step) is at least
-//!    `minArea`. Its outline is the rectangle between the two surfaces; its
-//!    points are labelled with it.
+//!    a piece is kept when its points cover at least `minOccupancy` of its
+//!    length (each point the `cell` after it) and its area (length times
+//!    step) is at least `minArea`. Its outline is the rectangle between the
+//!    two surfaces; its points are labelled with it. When the points come
+//!    from one sensor whose position is known ([`Spacing`]), both lengths
+//!    grow with the square of the range beyond `groundClusterRange`: a
+//!    laser ring hits a curb's face only where it crosses the curb's line,
+//!    so the runs of points on a face lie as far apart as the rings do on
+//!    the ground.
 
 use crate::geometry::plane::Moments;
 use crate::geometry::polygon::{make_ccw, segment_distance_sq, signed_area};
@@ -49,6 +54,31 @@ const MAX_TILT_DEG: f64 = 15.0;
 const MARGIN_RMS: f64 = 2.0;
 /// ...and beyond this share of the lower surface's inlier distance.
 const MARGIN_FLOOR: f64 = 0.25;
+
+/// How far apart a face's evidence lies along it: as far as the laser
+/// rings lie on the ground, which grows with the square of the range from
+/// the sensor's foot beyond `range` (`groundClusterRange`; the ground's
+/// range-pulled clustering follows the same law, `geometry::pull_range`).
+/// Without a foot (a cloud seen from many poses, or from nowhere known)
+/// the spacing is the same everywhere.
+#[derive(Clone, Copy)]
+pub(crate) struct Spacing {
+    /// The plan position of the one sensor the points were seen from.
+    pub foot: Option<DVec2>,
+    pub range: f64,
+}
+
+impl Spacing {
+    /// How many times the near spacing the evidence at plan point `q` may
+    /// leave between its runs: `(r / range)^2` at range `r` beyond
+    /// `range`, 1 nearer.
+    fn scale(&self, q: DVec2) -> f64 {
+        let Some(foot) = self.foot else {
+            return 1.0;
+        };
+        ((q - foot).length_squared() / (self.range * self.range)).max(1.0)
+    }
+}
 
 /// The plan box (world x, y) a riser can lie in: the points' box, grown by
 /// the reach. Outline edges outside it are not looked at (the scenario's
@@ -299,12 +329,13 @@ pub(crate) fn add_risers(
     origin: DVec3,
     viewpoint: DVec3,
     p: &Params,
+    spacing: Spacing,
 ) {
     let n = primitives.len();
     let every = vec![true; n];
     let slot = |l: u32| ((l as usize) < n).then_some(l as usize);
     let found = find_risers(
-        primitives, &every, &slot, labels, pts, origin, viewpoint, p, p.min_area,
+        primitives, &every, &slot, labels, pts, origin, viewpoint, p, p.min_area, spacing,
     );
     for (r, points) in found {
         if primitives.len() >= p.max_primitives {
@@ -341,6 +372,7 @@ pub(crate) fn find_risers(
     viewpoint: DVec3,
     p: &Params,
     min_area: f64,
+    spacing: Spacing,
 ) -> Vec<(Primitive, Vec<u32>)> {
     let reach = p.ground.cluster_tolerance.max(p.other.cluster_tolerance);
     let Some(window) = Window::of(pts, origin, reach) else {
@@ -363,8 +395,9 @@ pub(crate) fn find_risers(
     merge_faces(&mut faces, pts, origin, tol, 2.0 * p.other.alpha);
     let mut out = Vec::new();
     for face in &faces {
-        for piece in split(face, pts, origin, 2.0 * p.other.alpha) {
-            out.extend(riser(face, &piece, pts, origin, viewpoint, p, min_area));
+        for piece in split(face, pts, origin, 2.0 * p.other.alpha, spacing) {
+            let plan = Plan { pts, origin };
+            out.extend(riser(face, &piece, plan, viewpoint, p, min_area, spacing));
         }
     }
     out
@@ -783,8 +816,9 @@ fn height(plane: &Plane, q: DVec2) -> f64 {
 }
 
 /// Step 4: a face's points, cut where they leave a gap wider than `gap`
-/// along its line; each piece in order along it.
-fn split(face: &Face, pts: &[Vec3], origin: DVec3, gap: f64) -> Vec<Vec<u32>> {
+/// (times the [`Spacing`] at the gap's middle) along its line; each piece
+/// in order along it.
+fn split(face: &Face, pts: &[Vec3], origin: DVec3, gap: f64, spacing: Spacing) -> Vec<Vec<u32>> {
     let along: Vec<f64> = face
         .points
         .iter()
@@ -793,13 +827,13 @@ fn split(face: &Face, pts: &[Vec3], origin: DVec3, gap: f64) -> Vec<Vec<u32>> {
                 .dot((origin + pts[i as usize].as_dvec3()).truncate() - face.at)
         })
         .collect();
-    // The cuts: the starts of the gaps wider than `gap` between the sorted
-    // positions; a point's piece is the number of cuts below it.
+    // The cuts: the starts of the gaps wider than allowed between the
+    // sorted positions; a point's piece is the number of cuts below it.
     let mut sorted = along.clone();
     sorted.sort_by(f64::total_cmp);
     let cuts: Vec<f64> = sorted
         .windows(2)
-        .filter(|w| w[1] - w[0] > gap)
+        .filter(|w| w[1] - w[0] > gap * spacing.scale(face.at + face.dir * (0.5 * (w[0] + w[1]))))
         .map(|w| w[0])
         .collect();
     let mut out: Vec<Vec<u32>> = vec![Vec::new(); cuts.len() + 1];
@@ -814,14 +848,15 @@ fn split(face: &Face, pts: &[Vec3], origin: DVec3, gap: f64) -> Vec<Vec<u32>> {
 fn riser(
     face: &Face,
     piece: &[u32],
-    pts: &[Vec3],
-    origin: DVec3,
+    plan: Plan,
     viewpoint: DVec3,
     p: &Params,
     min_area: f64,
+    spacing: Spacing,
 ) -> Option<(Primitive, Vec<u32>)> {
+    let Plan { pts, origin } = plan;
     let world = |i: u32| origin + pts[i as usize].as_dvec3();
-    let (at, dir) = line_fit(Plan { pts, origin }, piece, face.dir)?;
+    let (at, dir) = line_fit(plan, piece, face.dir)?;
     // Upright between the two surfaces, along the line.
     let up = (face.lower.normal + face.upper.normal).normalize_or_zero();
     let normal = dir.extend(0.0).cross(up).normalize_or_zero();
@@ -836,7 +871,7 @@ fn riser(
         .copied()
         .filter(|&i| plane.signed_distance(world(i)).abs() < tol)
         .collect();
-    let along: Vec<f64> = kept
+    let mut along: Vec<f64> = kept
         .iter()
         .map(|&i| dir.dot(world(i).truncate() - at))
         .collect();
@@ -846,11 +881,20 @@ fn riser(
         return None;
     }
     let cell = p.other.cell;
-    // The share of the `cell` bins along its extent that hold a point.
-    let mut bins: Vec<f64> = along.iter().map(|&s| ((s - s0) / cell).floor()).collect();
-    bins.sort_by(f64::total_cmp);
-    bins.dedup();
-    let occupancy = bins.len() as f64 / ((s1 - s0) / cell).ceil().max(1.0);
+    // The share of its extent (at least a cell) that its points cover,
+    // each the `cell` after it times the spacing at its range.
+    let len = (s1 - s0).max(cell);
+    along.sort_by(f64::total_cmp);
+    let (mut covered, mut end) = (0.0, s0);
+    for s in along {
+        let b = s + cell * spacing.scale(at + dir * s);
+        let (a, b) = (s.max(end), b.min(s0 + len));
+        if b > a {
+            covered += b - a;
+            end = b;
+        }
+    }
+    let occupancy = covered / len;
     if occupancy < p.min_occupancy {
         return None;
     }
@@ -988,7 +1032,7 @@ mod tests {
                 .len(),
             2
         );
-        // Points on a quarter of it only: its bins are not filled enough.
+        // Points on a quarter of it only: they cover too little of it.
         let mut pts = curb(0.15, 0);
         for k in 0..100 {
             pts.extend([k as f32 * 0.05, 0.0, 0.075]);
@@ -1016,6 +1060,45 @@ mod tests {
                 .len(),
             2
         );
+    }
+
+    #[test]
+    fn a_far_curb_seen_in_runs_of_points_is_one_riser() {
+        // The curb 30-50 m from the sensor's foot (x = -30): its face holds
+        // runs of points 0.4 m long every 1.5 m, where laser rings cross
+        // it. Gaps of 1.1 m are over `2 * alpha` (1 m), so each run alone
+        // would be a piece, far below `minArea`; at these ranges the rings
+        // lie 2.25-6.25 times as far apart as within `groundClusterRange`.
+        let mut pts = curb(0.15, 0);
+        for k in 0..14 {
+            for i in 0..9 {
+                let x = 0.05 + 1.5 * k as f32 + 0.05 * i as f32;
+                pts.extend([x, 0.0, 0.045 + 0.015 * (i % 5) as f32]);
+            }
+        }
+        let cloud = Cloud::from_flat(&pts, 3).unwrap();
+        let viewpoint = DVec3::new(-30.0, -3.0, 1.8);
+        let p = Params {
+            viewpoint: Some(viewpoint.to_array()),
+            ..Params::gpp2()
+        };
+        let run = |policy| Detector::new(&p, policy).run(&cloud.points, cloud.origin, viewpoint);
+        let det = run(CascadePolicy::one_shot());
+        assert_eq!(det.primitives.len(), 3, "road, sidewalk and curb");
+        let v = det.primitives[2].vertices();
+        let (lo, hi) = v
+            .iter()
+            .fold((DVec3::splat(1e9), DVec3::splat(-1e9)), |(a, b), &q| {
+                (a.min(q), b.max(q))
+            });
+        assert!(lo.y.abs() < 0.01 && hi.y.abs() < 0.01, "{lo} {hi}");
+        assert!(lo.x < 0.1 && hi.x > 19.9, "one riser end to end: {lo} {hi}");
+        // Judged as if seen from everywhere alike, the runs fall apart.
+        let alike = CascadePolicy {
+            range_pulled_ground: false,
+            ..CascadePolicy::one_shot()
+        };
+        assert_eq!(run(alike).primitives.len(), 2);
     }
 
     #[test]

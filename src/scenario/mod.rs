@@ -427,6 +427,10 @@ impl Scenario {
             sensor,
             p,
             0.0,
+            crate::detect::riser::Spacing {
+                foot: Some(sensor.truncate()),
+                range: p.ground_cluster_range,
+            },
         );
         // Those large enough first, each a new primitive; then the pieces
         // too small to stand alone (a scan sees a few metres of a curb),
