@@ -63,8 +63,10 @@ const MARGIN_FLOOR: f64 = 0.25;
 /// the spacing is the same everywhere.
 #[derive(Clone, Copy)]
 pub(crate) struct Spacing {
-    /// The plan position of the one sensor the points were seen from.
+    /// The plan position of the one sensor the points were seen from;
+    /// `None` for a cloud seen from many poses or from nowhere known.
     pub foot: Option<DVec2>,
+    /// `groundClusterRange` (m): within it the spacing is the near one.
     pub range: f64,
 }
 
