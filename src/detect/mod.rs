@@ -310,10 +310,7 @@ impl<'p> Detector<'p> {
                 origin,
                 viewpoint,
                 p,
-                riser::Spacing {
-                    foot: policy.range_pulled_ground.then(|| viewpoint.truncate()),
-                    range: p.ground_cluster_range,
-                },
+                policy.range_pulled_ground.then(|| viewpoint.truncate()),
             );
         }
         out.time_ms = clock::now_ms() - t0;

@@ -62,12 +62,12 @@ const MARGIN_FLOOR: f64 = 0.25;
 /// Without a foot (a cloud seen from many poses, or from nowhere known)
 /// the spacing is the same everywhere.
 #[derive(Clone, Copy)]
-pub(crate) struct Spacing {
+struct Spacing {
     /// The plan position of the one sensor the points were seen from;
     /// `None` for a cloud seen from many poses or from nowhere known.
-    pub foot: Option<DVec2>,
+    foot: Option<DVec2>,
     /// `groundClusterRange` (m): within it the spacing is the near one.
-    pub range: f64,
+    range: f64,
 }
 
 impl Spacing {
@@ -323,7 +323,7 @@ impl Plan<'_> {
 /// them and leave the support count of the surface they were labelled
 /// with. That surface's moments stay: they are the statistics of its
 /// robust refit (which trims most points this far off its plane), not a
-/// sum over its labels.
+/// sum over its labels. `foot`: as for [`find_risers`].
 pub(crate) fn add_risers(
     primitives: &mut Vec<Primitive>,
     labels: &mut [u32],
@@ -331,13 +331,13 @@ pub(crate) fn add_risers(
     origin: DVec3,
     viewpoint: DVec3,
     p: &Params,
-    spacing: Spacing,
+    foot: Option<DVec2>,
 ) {
     let n = primitives.len();
     let every = vec![true; n];
     let slot = |l: u32| ((l as usize) < n).then_some(l as usize);
     let found = find_risers(
-        primitives, &every, &slot, labels, pts, origin, viewpoint, p, p.min_area, spacing,
+        primitives, &every, &slot, labels, pts, origin, viewpoint, p, p.min_area, foot,
     );
     for (r, points) in found {
         if primitives.len() >= p.max_primitives {
@@ -362,7 +362,9 @@ pub(crate) fn add_risers(
 /// (`None`: a primitive not among them, whose points are no evidence).
 /// Points of a riser can hold a label of another one found here (the
 /// caller labels them in order, the last riser keeping them). Risers
-/// smaller than `min_area` are left out.
+/// smaller than `min_area` are left out. `foot`: the plan position of the
+/// one sensor the points were seen from, if known, which sets how far
+/// apart their evidence may lie ([`Spacing`]).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn find_risers(
     primitives: &[Primitive],
@@ -374,8 +376,12 @@ pub(crate) fn find_risers(
     viewpoint: DVec3,
     p: &Params,
     min_area: f64,
-    spacing: Spacing,
+    foot: Option<DVec2>,
 ) -> Vec<(Primitive, Vec<u32>)> {
+    let spacing = Spacing {
+        foot,
+        range: p.ground_cluster_range,
+    };
     let reach = p.ground.cluster_tolerance.max(p.other.cluster_tolerance);
     let Some(window) = Window::of(pts, origin, reach) else {
         return Vec::new();

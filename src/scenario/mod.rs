@@ -427,10 +427,7 @@ impl Scenario {
             sensor,
             p,
             0.0,
-            crate::detect::riser::Spacing {
-                foot: Some(sensor.truncate()),
-                range: p.ground_cluster_range,
-            },
+            Some(sensor.truncate()),
         );
         // Those large enough first, each a new primitive; then the pieces
         // too small to stand alone (a scan sees a few metres of a curb),
