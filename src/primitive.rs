@@ -152,7 +152,7 @@ impl Primitive {
     /// `None` for an outline, or support cells, two cells wide or more.
     fn thin_rectangle(&self) -> Option<Vec<DVec2>> {
         let hull = convex_hull(&self.outline)?;
-        let (width, along) = narrowest(&hull);
+        let (width, along) = narrowest_axis(&hull);
         let cell = self.footprint.cell();
         if width >= 2.0 * cell {
             return None;
@@ -175,6 +175,52 @@ impl Primitive {
         crate::geometry::polygon::make_ccw(&mut ring);
         Some(ring)
     }
+}
+
+/// The sense a thin rectangle's long axis is given: any fixed direction
+/// away from the frame's axes (along which strips run).
+const SENSE: DVec2 = DVec2::new(0.984_807_753_012_208, 0.173_648_177_666_930_3);
+
+/// Widths (m) closer than this to the smallest count as equal in
+/// [`narrowest_axis`].
+const WIDTH_TIE: f64 = 1e-6;
+
+/// The smallest width of a convex hull and the direction of its long axis:
+/// the mean direction of the hull edges as narrow as the narrowest (within
+/// [`WIDTH_TIE`]), in the sense of [`SENSE`]. A riser's quadrilateral
+/// (its long edges where its plane meets two surfaces a hair out of
+/// parallel) is exactly as narrow from either long edge, so rounding alone
+/// would pick one edge's direction or the other's; the mean does not
+/// depend on that.
+fn narrowest_axis(h: &[DVec2]) -> (f64, DVec2) {
+    let n = h.len();
+    let widths: Vec<(f64, DVec2)> = (0..n)
+        .map(|i| {
+            let (a, b) = (h[i], h[(i + 1) % n]);
+            let e = crate::geometry::unit_or_zero(b - a);
+            let w = h
+                .iter()
+                .map(|&p| e.perp_dot(p - a))
+                .fold(0.0f64, |w, d| if d > w { d } else { w });
+            (w, e)
+        })
+        .collect();
+    let best = widths
+        .iter()
+        .fold(f64::INFINITY, |b, &(w, _)| if w < b { w } else { b });
+    let sum = widths
+        .iter()
+        .filter(|&&(w, _)| w <= best + WIDTH_TIE)
+        .fold(DVec2::ZERO, |s, &(_, e)| {
+            s + if e.dot(SENSE) < 0.0 { -e } else { e }
+        });
+    let along = crate::geometry::unit_or_zero(sum);
+    let along = if along == DVec2::ZERO {
+        DVec2::X
+    } else {
+        along
+    };
+    (best, along)
 }
 
 /// The least and greatest of the points' coordinates along `dir`.
