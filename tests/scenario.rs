@@ -233,9 +233,12 @@ fn drive_through(layout: Layout) {
             ..Params::gpp2()
         };
         let one = if paper {
-            // The scenario's cascade with the paper's plain sampler.
+            // The scenario's cascade with the paper's plain sampler, and
+            // without the rules about the bands of crossing surfaces.
             let paper = CascadePolicy {
                 reject_slivers: false,
+                spare_crossing_surfaces: false,
+                judge_without_crossing_bands: false,
                 ..CascadePolicy::scenario_leftovers()
             };
             Detector::new(&params, paper).run(&cloud.points, cloud.origin, mean_pose)

@@ -429,14 +429,51 @@ impl<'p> Detector<'p> {
                     // Too rough, nothing else wrong, and in two layers: two
                     // surfaces a step apart. Judge the larger one alone; the
                     // rest of the cluster stays in play.
-                    let mut layer: Option<Vec<u32>> = None;
+                    let mut layer: Option<round::Candidate> = None;
                     if policy.split_rough_layers && judged.only_too_rough {
                         if let Some((near, again)) = judge.dominant_layer(&judged, support_pts) {
-                            layer = Some(near.iter().map(|&i| cluster[i]).collect());
+                            layer =
+                                Some(near.iter().map(|&i| (cluster[i], support_pts[i])).unzip());
                             judged = again;
                         }
                     }
-                    let cluster: &Vec<u32> = layer.as_ref().unwrap_or(cluster);
+                    // By policy, a candidate more than half of whose points
+                    // lie on other surfaces crossing its plane holds their
+                    // bands: it is judged again without them (a car's roof
+                    // with the top rows of its sides), and when that fails
+                    // it is a plane through the bands, not a surface
+                    // (rejected, the bands spared, the plane set aside).
+                    let mut banded = false;
+                    if policy.spare_crossing_surfaces
+                        && policy.judge_without_crossing_bands
+                        && judged.accepted
+                    {
+                        let (cluster, support_pts) = layer
+                            .as_ref()
+                            .map_or((&cluster[..], &support_pts[..]), |(c, s)| (c, s));
+                        let normal = judged.shaped.as_ref().map(|s| s.primitive.plane.normal);
+                        let spread = scattered_spread(&mut accepted_rms, p);
+                        let on = normal.map_or_else(Vec::new, |n| {
+                            pool.on_crossing_surfaces(cluster, n, SCATTERED_MIN_POINTS, spread)
+                        });
+                        if 2 * on.iter().filter(|&&b| b).count() > cluster.len() {
+                            let own: round::Candidate = cluster
+                                .iter()
+                                .zip(support_pts)
+                                .zip(&on)
+                                .filter_map(|((&v, &q), &b)| (!b).then_some((v, q)))
+                                .unzip();
+                            let again = judge.judge(&own.1);
+                            if again.accepted {
+                                layer = Some(own);
+                                judged = again;
+                            } else {
+                                judged.accepted = false;
+                                banded = true;
+                            }
+                        }
+                    }
+                    let cluster: &Vec<u32> = layer.as_ref().map_or(cluster, |(c, _)| c);
                     // 6. Accept and take the support out of play, or take out
                     //    the whole largest cluster (with the plane fitted to
                     //    it, it would come back the same).
@@ -468,7 +505,9 @@ impl<'p> Detector<'p> {
                         }
                         // By policy, the bands of other surfaces it crossed
                         // stay in play, and the plane is not tried again.
-                        _ if policy.spare_crossing_surfaces && policy.spare_rejected => {
+                        _ if policy.spare_crossing_surfaces
+                            && (banded || policy.spare_rejected) =>
+                        {
                             let spread = scattered_spread(&mut accepted_rms, p);
                             pool.set_aside(cluster, &plane, SCATTERED_MIN_POINTS, spread);
                         }

@@ -1,5 +1,5 @@
 //! Which of the cascade's rules apply: one-shot detection and the
-//! scenario's detection on each scan's leftovers differ in twelve of them.
+//! scenario's detection on each scan's leftovers differ in thirteen of them.
 
 /// The rule set of one detection cascade. The parameters ([`Params`])
 /// say how much (distances, areas, budgets); the policy says which rules
@@ -93,6 +93,21 @@ pub struct CascadePolicy {
     ///
     /// [`spare_crossing_surfaces`]: CascadePolicy::spare_crossing_surfaces
     pub spare_rejected: bool,
+    /// With [`spare_crossing_surfaces`], a candidate more than half of
+    /// whose points lie on other surfaces crossing its plane (by the same
+    /// test) is judged again on its other points alone, and when that
+    /// fails it is rejected as a plane through their bands (its points
+    /// spared, its plane set aside). The bands that sparing keeps in play
+    /// can line up with a plane of their own: the edges of a row of parked
+    /// cars' roofs and the road beside their feet hold a slab at 48 degrees
+    /// that passes every other test. A roof seen at a grazing angle, whose
+    /// candidate holds the top rows of the car's sides, keeps its own
+    /// points. Off in one-shot detection for now (BENCHMARKS.md: it makes
+    /// the one-shot more precise than the scenario's map by more than
+    /// `tests/scenario.rs` allows).
+    ///
+    /// [`spare_crossing_surfaces`]: CascadePolicy::spare_crossing_surfaces
+    pub judge_without_crossing_bands: bool,
     /// After the merge pass, the short faces between two near-horizontal
     /// primitives a step apart (curbs, steps) become primitives of their
     /// own where points fill the step (see the `riser` module): such a face
@@ -137,6 +152,7 @@ impl CascadePolicy {
             clear_scattered_on_stall: true,
             spare_crossing_surfaces: true,
             spare_rejected: true,
+            judge_without_crossing_bands: false,
             find_risers: true,
             coarse_pass: false,
         }
@@ -169,9 +185,15 @@ impl CascadePolicy {
     /// voxel grid, and three points of one ring fix a line, not a plane.
     /// Judging every cluster there measured less precise and less
     /// accurate, the growing ground tolerance neutral, and clearing
-    /// scattered voxels at a stall finding fewer surfaces, less precisely,
-    /// and sparing crossing surfaces mixed (crossing recall down, more
-    /// polygons with drifting poses; BENCHMARKS.md). Triples may reach
+    /// scattered voxels at a stall finding fewer surfaces, less precisely
+    /// (BENCHMARKS.md). Crossing surfaces are spared: a round whose plane
+    /// has no large enough patch would otherwise take every band of the
+    /// far car sides it crosses out of play, and the cascade stops at
+    /// `maxRejections` before any round reaches them; a candidate made
+    /// mostly of such bands is judged without them
+    /// (`judge_without_crossing_bands`). A rejected candidate's points are
+    /// not spared (on the own simulator's street drive that made the map
+    /// less precise and 4x less accurate). Triples may reach
     /// across the cloud from a sparse voxel, as in the paper's sampler:
     /// with local triples only, one primitive of the simulated street's
     /// first scan came out tilted enough for the second scan's alignment
@@ -200,8 +222,9 @@ impl CascadePolicy {
             merge_pieces: false,
             split_rough_layers: false,
             clear_scattered_on_stall: false,
-            spare_crossing_surfaces: false,
+            spare_crossing_surfaces: true,
             spare_rejected: false,
+            judge_without_crossing_bands: true,
             find_risers: false,
             coarse_pass: false,
         }
