@@ -296,6 +296,117 @@ impl Shaped {
     }
 }
 
+/// Share of a support's spread off its plane that a quadric surface must
+/// explain, and turn (degrees) its normal must make across the support, for
+/// [`Shaped::domed`].
+const DOME_EXPLAINED: f64 = 0.5;
+const DOME_TURN_DEG: f64 = 20.0;
+
+impl Shaped {
+    /// Is this a dome seen from below (a tree crown's underside), not a
+    /// surface? Its normal, turned towards the sensor, points down, its
+    /// points lie above the sensor on average, and they bend: a quadric height field over the plane explains more
+    /// than half of their spread off it, and that quadric's normal turns by
+    /// more than 20 degrees across them (between the median point and the
+    /// 90th percentile of the turn, doubled). A plane slab cut from a
+    /// sphere's underside passes every other test: its points fill the
+    /// slab's lower half evenly enough to be smooth and its patches lean
+    /// less than 15 degrees. A real surface seen from below (a ceiling, an
+    /// awning) is flat; a car's body, which bends as much, is seen from
+    /// above or from the side. `origin` and `pts` are what [`shape`] was
+    /// given; large supports are judged on an even-strided subsample of
+    /// 20,000 points.
+    pub fn domed(&self, origin: DVec3, pts: &[Vec3], viewpoint: DVec3) -> bool {
+        let f = &self.primitive.frame;
+        if f.normal.z >= 0.0 {
+            return false;
+        }
+        let step = pts.len().div_ceil(20_000).max(1);
+        let rows: Vec<(DVec2, f64)> = (0..pts.len())
+            .step_by(step)
+            .filter(|&i| self.kept[i])
+            .map(|i| {
+                (
+                    self.q[i],
+                    f.normal.dot(origin + pts[i].as_dvec3() - f.origin),
+                )
+            })
+            .collect();
+        if rows.len() < 12 {
+            return false;
+        }
+        let n = rows.len() as f64;
+        // Above the sensor: below it, a sparse face's few laser rings (a
+        // far car's side) fit a quadric in their handful of heights.
+        let height = (0..pts.len())
+            .step_by(step)
+            .filter(|&i| self.kept[i])
+            .map(|i| origin.z + f64::from(pts[i].z))
+            .sum::<f64>()
+            / n;
+        if height <= viewpoint.z {
+            return false;
+        }
+        let mid = rows.iter().fold(DVec2::ZERO, |m, r| m + r.0 / n);
+        let mean = rows.iter().map(|r| r.1).sum::<f64>() / n;
+        let basis = |q: DVec2| {
+            let (x, y) = (q.x - mid.x, q.y - mid.y);
+            [x * x, x * y, y * y, x, y, 1.0]
+        };
+        // Least squares by the normal equations (6 x 6, partial pivoting).
+        let mut m = [[0.0f64; 7]; 6];
+        for &(q, d) in &rows {
+            let b = basis(q);
+            for (i, row) in m.iter_mut().enumerate() {
+                for (j, cell) in row.iter_mut().take(6).enumerate() {
+                    *cell += b[i] * b[j];
+                }
+                row[6] += b[i] * d;
+            }
+        }
+        for c in 0..6 {
+            let pivot = (c..6).fold(c, |p, r| if m[r][c].abs() > m[p][c].abs() { r } else { p });
+            m.swap(c, pivot);
+            let lead = m[c][c];
+            // Singular (or NaN): no quadric, no dome.
+            if lead.abs().partial_cmp(&1e-12) != Some(std::cmp::Ordering::Greater) {
+                return false;
+            }
+            let pivot_row = m[c];
+            for (r, row) in m.iter_mut().enumerate() {
+                if r != c {
+                    let k = row[c] / lead;
+                    for (x, &y) in row.iter_mut().zip(&pivot_row).skip(c) {
+                        *x -= k * y;
+                    }
+                }
+            }
+        }
+        let co: [f64; 6] = std::array::from_fn(|c| m[c][6] / m[c][c]);
+        let (mut spread, mut residual) = (0.0, 0.0);
+        let mut turn: Vec<f64> = Vec::with_capacity(rows.len());
+        for &(q, d) in &rows {
+            let b = basis(q);
+            let fit: f64 = b.iter().zip(&co).map(|(b, c)| b * c).sum();
+            spread += (d - mean) * (d - mean);
+            residual += (d - fit) * (d - fit);
+            let slope = DVec2::new(
+                2.0 * co[0] * b[3] + co[1] * b[4],
+                co[1] * b[3] + 2.0 * co[2] * b[4],
+            );
+            turn.push(slope.length());
+        }
+        if spread.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+            || residual > (1.0 - DOME_EXPLAINED) * spread
+        {
+            return false;
+        }
+        let k = turn.len() * 9 / 10;
+        let s = *turn.select_nth_unstable_by(k, f64::total_cmp).1;
+        2.0 * libm::atan(s).to_degrees() > DOME_TURN_DEG
+    }
+}
+
 /// See [`Shaped::consistency`].
 fn normal_consistency(
     origin: DVec3,
@@ -510,6 +621,54 @@ mod tests {
             born_scan: 0,
             last_scan: 0,
         }
+    }
+
+    /// The points of a tree crown's underside (a sphere of radius 2 m whose
+    /// bottom is 2.5 m up) within 0.1 m of its lowest point, or a flat
+    /// disc as wide at the same height, every 5 cm.
+    fn underside(domed: bool) -> Vec<Vec3> {
+        let mut pts = Vec::new();
+        for i in -20..=20 {
+            for j in -20..=20 {
+                let (x, y) = (0.05 * i as f64, 0.05 * j as f64);
+                let r2 = x * x + y * y;
+                if 2.0 - (4.0 - r2).max(0.0).sqrt() > 0.1 {
+                    continue;
+                }
+                let z = if domed { 4.5 - (4.0 - r2).sqrt() } else { 2.5 };
+                pts.push(Vec3::new(x as f32, y as f32, z as f32));
+            }
+        }
+        pts
+    }
+
+    #[test]
+    fn a_crown_underside_is_a_dome_and_a_ceiling_is_not() {
+        let p = Params::gpp2();
+        let judge = |pts: &[Vec3], viewpoint: DVec3| {
+            let s = shape(
+                DVec3::ZERO,
+                pts,
+                &p,
+                viewpoint,
+                GroundRule::BelowViewpoint,
+                false,
+            )
+            .expect("a primitive");
+            assert!(s.roughness <= p.max_roughness, "{}", s.roughness);
+            s.domed(DVec3::ZERO, pts, viewpoint)
+        };
+        let below = DVec3::new(3.0, 0.0, 1.8);
+        assert!(judge(&underside(true), below));
+        assert!(!judge(&underside(false), below), "a flat ceiling");
+        // The same bend seen from above (a bowl), or with the sensor
+        // higher than the points, is no crown's underside.
+        assert!(!judge(&underside(true), DVec3::new(3.0, 0.0, 9.0)));
+        let mut low = underside(true);
+        for q in &mut low {
+            q.z -= 2.0;
+        }
+        assert!(!judge(&low, DVec3::new(3.0, 0.0, 1.8)));
     }
 
     #[test]

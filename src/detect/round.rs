@@ -151,7 +151,8 @@ impl Judge<'_> {
     /// PCA refit, frame, outline, then the acceptance tests: area, width
     /// and solidity
     /// ([`Primitive::acceptable`](crate::primitive::Primitive::acceptable)),
-    /// roughness, not a plane seen edge-on, normal consistency.
+    /// roughness, not a plane seen edge-on, not a dome seen from below (by
+    /// policy), normal consistency.
     pub(crate) fn judge(&self, support_pts: &[Vec3]) -> Judged {
         let (p, viewpoint) = (self.p, self.viewpoint);
         let shaped = shape(
@@ -165,6 +166,7 @@ impl Judge<'_> {
         let rest_ok = |s: &Shaped| {
             s.primitive.acceptable(p)
                 && !(self.policy.reject_edge_on_candidates && seen_edge_on(s, viewpoint, p))
+                && !(self.policy.reject_domes && s.domed(self.origin, support_pts, viewpoint))
                 && s.consistency(self.origin, support_pts, p) >= p.min_normal_consistency
         };
         let smooth = shaped
