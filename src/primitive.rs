@@ -305,10 +305,11 @@ const DOME_TURN_DEG: f64 = 20.0;
 impl Shaped {
     /// Is this a dome seen from below (a tree crown's underside), not a
     /// surface? Its normal, turned towards the sensor, points down, its
-    /// points lie above the sensor on average, and they bend: a quadric height field over the plane explains more
-    /// than half of their spread off it, and that quadric's normal turns by
-    /// more than 20 degrees across them (between the median point and the
-    /// 90th percentile of the turn, doubled). A plane slab cut from a
+    /// points lie above the sensor on average, and they bend: a quadric
+    /// height field over the plane explains more than half of their spread
+    /// off it, and that quadric's normal turns by more than 20 degrees
+    /// across them (twice its turn from the support's centre to the 90th
+    /// percentile of the points). A plane slab cut from a
     /// sphere's underside passes every other test: its points fill the
     /// slab's lower half evenly enough to be smooth and its patches lean
     /// less than 15 degrees. A real surface seen from below (a ceiling, an

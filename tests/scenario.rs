@@ -307,11 +307,11 @@ fn drive_through(layout: Layout) {
     // polyscene's one-shot on the whole drive (measured: street
     // P 0.988 R 0.477 C 0.869, 3 duplicate pairs; crossing P 0.989
     // R 0.487 C 0.863, 2): the scenario finds more of the scene (1.57x
-    // and 1.29x the surfaces; 1.76x and 1.46x before one-shot detection
+    // and 1.28x the surfaces; 1.76x and 1.46x before one-shot detection
     // drew its triples from one voxel only), without duplicates, and
-    // stays about as precise (P 0.991 and 0.987). The one-shot's area-weighted
+    // stays as precise (P 0.991 and 0.991). The one-shot's area-weighted
     // mean error is the lower one (street 4.0 vs 5.3 mm, crossing 4.1 vs
-    // 4.9 mm): it fits each surface to the whole
+    // 4.3 mm): it fits each surface to the whole
     // drive at once, and leaves out most of the vehicle faces. So the mean
     // is not compared here; BENCHMARKS.md gives both. The scenario must
     // cover at least nine tenths of what the one-shot covers (it covers
@@ -369,8 +369,8 @@ fn drive_through(layout: Layout) {
         "{layout:?} vehicle ends: {kinds:?}"
     );
     // Absolute floors below the measured values (BENCHMARKS.md): street /
-    // crossing P 0.991 / 0.987, R 0.749 / 0.630, C 0.935 / 0.918, mean
-    // 5.3 / 4.9 mm.
+    // crossing P 0.991 / 0.991, R 0.749 / 0.625, C 0.935 / 0.915, mean
+    // 5.3 / 4.3 mm.
     assert!(inc.detection.precision > 0.985, "precision");
     assert!(inc.detection.recall > 0.5, "recall");
     assert!(inc.completeness.completeness > 0.85, "completeness");
