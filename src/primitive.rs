@@ -7,7 +7,7 @@ use crate::geometry::plane::{robust_fit, RobustFit};
 use crate::geometry::polygon::signed_area;
 use crate::geometry::{convex_hull, Footprint, Frame, Moments, Plane, Polygon3};
 use crate::params::{HullKind, Params, SolidityKind};
-use glam::{DVec2, DVec3, Vec3};
+use glam::{DMat3, DVec2, DVec3, Vec3};
 use serde::{Deserialize, Serialize};
 
 /// Label of a point that no primitive explains.
@@ -234,29 +234,7 @@ fn span(pts: impl Iterator<Item = DVec2>, dir: DVec2) -> (f64, f64) {
 /// Smallest width of the outline's convex hull (rotating calipers over the
 /// hull edges), in metres.
 pub fn min_width(ring: &[DVec2]) -> f64 {
-    convex_hull(ring).map_or(0.0, |h| narrowest(&h).0)
-}
-
-/// The smallest width of a convex hull and the direction of the hull edge
-/// it is measured from (rotating calipers over the edges).
-fn narrowest(h: &[DVec2]) -> (f64, DVec2) {
-    let n = h.len();
-    let (mut best, mut along) = (f64::INFINITY, DVec2::X);
-    for i in 0..n {
-        let (a, b) = (h[i], h[(i + 1) % n]);
-        let e = crate::geometry::unit_or_zero(b - a);
-        // Comparisons, not `f64::max`/`min` (which also test for NaN in
-        // wasm): the same result (a NaN would be skipped by both).
-        let mut w = 0.0f64;
-        for &p in h {
-            let d = e.perp_dot(p - a);
-            w = if d > w { d } else { w };
-        }
-        if w < best {
-            (best, along) = (w, e);
-        }
-    }
-    (best, along)
+    convex_hull(ring).map_or(0.0, |h| narrowest_axis(&h).0)
 }
 
 /// The result of shaping a support set: the primitive (id 0, scans 0) and
@@ -296,115 +274,92 @@ impl Shaped {
     }
 }
 
-/// Share of a support's spread off its plane that a quadric surface must
-/// explain, and turn (degrees) its normal must make across the support, for
-/// [`Shaped::domed`].
+/// Share of a support's spread off its plane that a quadric must explain,
+/// and the 90th percentile of that quadric's slope over the points that it
+/// must exceed (tan 10 degrees: its normal turns by 20 degrees across
+/// them), for [`Shaped::domed`].
 const DOME_EXPLAINED: f64 = 0.5;
-const DOME_TURN_DEG: f64 = 20.0;
+const DOME_SLOPE: f64 = 0.176_326_980_708_464_98;
 
 impl Shaped {
     /// Is this a dome seen from below (a tree crown's underside), not a
     /// surface? Its normal, turned towards the sensor, points down, its
     /// points lie above the sensor on average, and they bend: a quadric
-    /// height field over the plane explains more than half of their spread
-    /// off it, and that quadric's normal turns by more than 20 degrees
-    /// across them (twice its turn from the support's centre to the 90th
-    /// percentile of the points). A plane slab cut from a
-    /// sphere's underside passes every other test: its points fill the
-    /// slab's lower half evenly enough to be smooth and its patches lean
-    /// less than 15 degrees. A real surface seen from below (a ceiling, an
-    /// awning) is flat; a car's body, which bends as much, is seen from
-    /// above or from the side. `origin` and `pts` are what [`shape`] was
-    /// given; large supports are judged on an even-strided subsample of
-    /// 20,000 points.
+    /// about their centre (the distance off the plane as `a x^2 + b x y +
+    /// c y^2` plus a constant) explains more than half of their spread off
+    /// the plane, and its normal turns by more than 20 degrees across them
+    /// (twice the 90th percentile of its slope over the points). A plane slab cut from a crown's underside
+    /// passes every other test: its points fill the slab's lower half
+    /// evenly enough to be smooth and its patches lean less than 15
+    /// degrees. A real surface seen from below (a ceiling, an awning) is
+    /// flat; a car's body, which bends as much, is seen from above or from
+    /// the side. `origin` and `pts` are what [`shape`] was given; large
+    /// supports are judged on an even-strided subsample of 20,000 points.
     pub fn domed(&self, origin: DVec3, pts: &[Vec3], viewpoint: DVec3) -> bool {
         let f = &self.primitive.frame;
         if f.normal.z >= 0.0 {
             return false;
         }
         let step = pts.len().div_ceil(20_000).max(1);
-        let rows: Vec<(DVec2, f64)> = (0..pts.len())
+        let chosen: Vec<usize> = (0..pts.len())
             .step_by(step)
             .filter(|&i| self.kept[i])
-            .map(|i| {
-                (
-                    self.q[i],
-                    f.normal.dot(origin + pts[i].as_dvec3() - f.origin),
-                )
-            })
             .collect();
-        if rows.len() < 12 {
+        let n = chosen.len() as f64;
+        if chosen.len() < 12 {
             return false;
         }
-        let n = rows.len() as f64;
         // Above the sensor: below it, a sparse face's few laser rings (a
-        // far car's side) fit a quadric in their handful of heights.
-        let height = (0..pts.len())
-            .step_by(step)
-            .filter(|&i| self.kept[i])
-            .map(|i| origin.z + f64::from(pts[i].z))
+        // far car's side) bend any fit in their handful of heights.
+        let height = chosen
+            .iter()
+            .map(|&i| origin.z + f64::from(pts[i].z))
             .sum::<f64>()
             / n;
         if height <= viewpoint.z {
             return false;
         }
-        let mid = rows.iter().fold(DVec2::ZERO, |m, r| m + r.0 / n);
-        let mean = rows.iter().map(|r| r.1).sum::<f64>() / n;
-        let basis = |q: DVec2| {
-            let (x, y) = (q.x - mid.x, q.y - mid.y);
-            [x * x, x * y, y * y, x, y, 1.0]
-        };
-        // Least squares by the normal equations (6 x 6, partial pivoting).
-        let mut m = [[0.0f64; 7]; 6];
-        for &(q, d) in &rows {
-            let b = basis(q);
-            for (i, row) in m.iter_mut().enumerate() {
-                for (j, cell) in row.iter_mut().take(6).enumerate() {
-                    *cell += b[i] * b[j];
-                }
-                row[6] += b[i] * d;
-            }
+        let mid = chosen.iter().fold(DVec2::ZERO, |m, &i| m + self.q[i]) / n;
+        // (offset from the centre, distance off the plane)
+        let rows: Vec<(DVec2, f64)> = chosen
+            .iter()
+            .map(|&i| {
+                let off = f.normal.dot(origin + pts[i].as_dvec3() - f.origin);
+                (self.q[i] - mid, off)
+            })
+            .collect();
+        let terms = |u: DVec2| DVec3::new(u.x * u.x, u.x * u.y, u.y * u.y);
+        let (mx, md) = rows.iter().fold((DVec3::ZERO, 0.0), |(a, b), &(u, d)| {
+            (a + terms(u) / n, b + d / n)
+        });
+        // Least squares `d = a x^2 + b x y + c y^2 + e` (a quadric about
+        // the centre), by the normal equations of the centred terms.
+        let (mut xx, mut xd, mut sdd) = (DMat3::ZERO, DVec3::ZERO, 0.0);
+        for &(u, d) in &rows {
+            let x = terms(u) - mx;
+            xx += DMat3::from_cols(x * x.x, x * x.y, x * x.z);
+            xd += x * (d - md);
+            sdd += (d - md) * (d - md);
         }
-        for c in 0..6 {
-            let pivot = (c..6).fold(c, |p, r| if m[r][c].abs() > m[p][c].abs() { r } else { p });
-            m.swap(c, pivot);
-            let lead = m[c][c];
-            // Singular (or NaN): no quadric, no dome.
-            if lead.abs().partial_cmp(&1e-12) != Some(std::cmp::Ordering::Greater) {
-                return false;
-            }
-            let pivot_row = m[c];
-            for (r, row) in m.iter_mut().enumerate() {
-                if r != c {
-                    let k = row[c] / lead;
-                    for (x, &y) in row.iter_mut().zip(&pivot_row).skip(c) {
-                        *x -= k * y;
-                    }
-                }
-            }
-        }
-        let co: [f64; 6] = std::array::from_fn(|c| m[c][6] / m[c][c]);
-        let (mut spread, mut residual) = (0.0, 0.0);
-        let mut turn: Vec<f64> = Vec::with_capacity(rows.len());
-        for &(q, d) in &rows {
-            let b = basis(q);
-            let fit: f64 = b.iter().zip(&co).map(|(b, c)| b * c).sum();
-            spread += (d - mean) * (d - mean);
-            residual += (d - fit) * (d - fit);
-            let slope = DVec2::new(
-                2.0 * co[0] * b[3] + co[1] * b[4],
-                co[1] * b[3] + 2.0 * co[2] * b[4],
-            );
-            turn.push(slope.length());
-        }
-        if spread.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
-            || residual > (1.0 - DOME_EXPLAINED) * spread
-        {
+        // Singular (all points on a line or one spot), or NaN: no dome.
+        let scale = xx.x_axis.x * xx.y_axis.y * xx.z_axis.z;
+        if xx.determinant().partial_cmp(&(1e-12 * scale)) != Some(std::cmp::Ordering::Greater) {
             return false;
         }
-        let k = turn.len() * 9 / 10;
-        let s = *turn.select_nth_unstable_by(k, f64::total_cmp).1;
-        2.0 * libm::atan(s).to_degrees() > DOME_TURN_DEG
+        let co = xx.inverse() * xd;
+        // The share of the spread the fit explains.
+        if co.dot(xd) <= DOME_EXPLAINED * sdd {
+            return false;
+        }
+        // Its slope at each point, and the 90th percentile of that.
+        let mut slope: Vec<f64> = rows
+            .iter()
+            .map(|&(u, _)| {
+                DVec2::new(2.0 * co.x * u.x + co.y * u.y, co.y * u.x + 2.0 * co.z * u.y).length()
+            })
+            .collect();
+        slope.sort_by(f64::total_cmp);
+        2.0 * slope[slope.len() * 9 / 10] > DOME_SLOPE
     }
 }
 

@@ -432,8 +432,12 @@ impl<'p> Detector<'p> {
                     let mut layer: Option<round::Candidate> = None;
                     if policy.split_rough_layers && judged.only_too_rough {
                         if let Some((near, again)) = judge.dominant_layer(&judged, support_pts) {
-                            layer =
-                                Some(near.iter().map(|&i| (cluster[i], support_pts[i])).unzip());
+                            let (mut c, mut q) = (Vec::new(), Vec::new());
+                            for &i in &near {
+                                c.push(cluster[i]);
+                                q.push(support_pts[i]);
+                            }
+                            layer = Some((c, q));
                             judged = again;
                         }
                     }
@@ -453,16 +457,19 @@ impl<'p> Detector<'p> {
                             .map_or((&cluster[..], &support_pts[..]), |(c, s)| (c, s));
                         let normal = judged.shaped.as_ref().map(|s| s.primitive.plane.normal);
                         let spread = scattered_spread(&mut accepted_rms, p);
-                        let on = normal.map_or_else(Vec::new, |n| {
-                            pool.on_crossing_surfaces(cluster, n, SCATTERED_MIN_POINTS, spread)
+                        // In `cluster`'s order: a subsequence of it.
+                        let off = normal.map_or_else(Vec::new, |n| {
+                            pool.off_crossing_surfaces(cluster, n, SCATTERED_MIN_POINTS, spread)
                         });
-                        if 2 * on.iter().filter(|&&b| b).count() > cluster.len() {
-                            let own: round::Candidate = cluster
-                                .iter()
-                                .zip(support_pts)
-                                .zip(&on)
-                                .filter_map(|((&v, &q), &b)| (!b).then_some((v, q)))
-                                .unzip();
+                        if 2 * off.len() < cluster.len() {
+                            let (mut c, mut q) = (Vec::new(), Vec::new());
+                            for (&v, &w) in cluster.iter().zip(support_pts) {
+                                if off.get(c.len()) == Some(&v) {
+                                    c.push(v);
+                                    q.push(w);
+                                }
+                            }
+                            let own: round::Candidate = (c, q);
                             let again = judge.judge(&own.1);
                             if again.accepted {
                                 layer = Some(own);

@@ -453,45 +453,13 @@ impl PlanePool {
         smallest_eigen3(m.covariance()).map(|(l, v)| (l[0], v))
     }
 
-    /// Per point of `positions` (points of a plane with unit `normal`):
-    /// does it lie on another surface crossing the plane? It does when its
-    /// voxel holds at least `min_points` live points (and 4), they lie on a
-    /// plane of their own within `max_spread` (RMS, m), and that plane is
-    /// more than [`CROSSING_ANGLE`] degrees off `normal`. Positions in
-    /// voxel order (as [`PlanePool::best_plane`] gives them) judge each
-    /// voxel once.
-    pub(crate) fn on_crossing_surfaces(
-        &self,
-        positions: &[u32],
-        normal: DVec3,
-        min_points: usize,
-        max_spread: f64,
-    ) -> Vec<bool> {
-        let max_var = max_spread * max_spread;
-        let cos_max = CROSSING_ANGLE.to_radians().cos();
-        let mut last: Option<(u32, bool)> = None;
-        positions
-            .iter()
-            .map(|&pos| {
-                let c = self.cell_of[pos as usize];
-                match last {
-                    Some((lc, v)) if lc == c => v,
-                    _ => {
-                        let cu = c as usize;
-                        let v = self.cell_live[cu] as usize >= min_points.max(4)
-                            && self.voxel_plane(cu).is_some_and(|(var, n)| {
-                                var <= max_var && n.dot(normal).abs() < cos_max
-                            });
-                        last = Some((c, v));
-                        v
-                    }
-                }
-            })
-            .collect()
-    }
-
-    /// Of `positions`, those not on another surface crossing their plane
-    /// ([`PlanePool::on_crossing_surfaces`]).
+    /// Of `positions` (points of a plane with unit `normal`), those not on
+    /// another surface crossing it: a point is kept out of the answer when
+    /// its voxel holds at least `min_points` live points (and 4), they lie
+    /// on a plane of their own within `max_spread` (RMS, m), and that
+    /// plane is more than [`CROSSING_ANGLE`] degrees off `normal`.
+    /// Positions in voxel order (as [`PlanePool::best_plane`] gives them)
+    /// judge each voxel once.
     pub(crate) fn off_crossing_surfaces(
         &self,
         positions: &[u32],
@@ -499,12 +467,29 @@ impl PlanePool {
         min_points: usize,
         max_spread: f64,
     ) -> Vec<u32> {
-        let on = self.on_crossing_surfaces(positions, normal, min_points, max_spread);
-        positions
-            .iter()
-            .zip(on)
-            .filter_map(|(&pos, on)| (!on).then_some(pos))
-            .collect()
+        let max_var = max_spread * max_spread;
+        let cos_max = CROSSING_ANGLE.to_radians().cos();
+        let mut last: Option<(u32, bool)> = None;
+        let mut out = Vec::with_capacity(positions.len());
+        for &pos in positions {
+            let c = self.cell_of[pos as usize];
+            let crossing = match last {
+                Some((lc, v)) if lc == c => v,
+                _ => {
+                    let c = c as usize;
+                    let v = self.cell_live[c] as usize >= min_points.max(4)
+                        && self.voxel_plane(c).is_some_and(|(var, n)| {
+                            var <= max_var && n.dot(normal).abs() < cos_max
+                        });
+                    last = Some((c as u32, v));
+                    v
+                }
+            };
+            if !crossing {
+                out.push(pos);
+            }
+        }
+        out
     }
 
     /// Take `positions` (points of `plane` that explain nothing: a
