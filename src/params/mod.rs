@@ -201,7 +201,7 @@ macro_rules! options {
                     }),
                 )*];
                 for (key, value) in map {
-                    let name = snake(&key);
+                    let name = split_camel(&key, '_');
                     match SETTERS.iter().find(|(n, _)| *n == name) {
                         Some((_, set)) if camel(&name) == key => set(&mut w, value)?,
                         _ => return Err(unknown_field(&key)),
@@ -232,12 +232,13 @@ macro_rules! options {
 
 include!("table.rs");
 
-/// The snake_case name of a camelCase key.
-fn snake(key: &str) -> String {
+/// A camelCase key with its words split by `sep` and lowercased:
+/// `minArea` -> `min_area` (`sep` `_`), `min-area` (`-`).
+pub(crate) fn split_camel(key: &str, sep: char) -> String {
     let mut out = String::with_capacity(key.len() + 4);
     for c in key.chars() {
         if c.is_ascii_uppercase() {
-            out.push('_');
+            out.push(sep);
         }
         out.push(c.to_ascii_lowercase());
     }

@@ -177,20 +177,6 @@ struct OnDataArgs {
     radius: f64,
 }
 
-/// `minArea` -> `min-area`.
-fn kebab(key: &str) -> String {
-    let mut out = String::with_capacity(key.len() + 4);
-    for c in key.chars() {
-        if c.is_ascii_uppercase() {
-            out.push('-');
-            out.push(c.to_ascii_lowercase());
-        } else {
-            out.push(c);
-        }
-    }
-    out
-}
-
 /// One `--kebab-case` option per pipeline parameter, on `cmd`.
 fn with_pipeline_options(mut cmd: clap::Command) -> clap::Command {
     let defaults = serde_json::to_value(Params::gpp2()).unwrap_or_default();
@@ -210,7 +196,7 @@ fn with_pipeline_options(mut cmd: clap::Command) -> clap::Command {
         };
         cmd = cmd.arg(
             Arg::new(key.clone())
-                .long(kebab(&key))
+                .long(crate::params::split_camel(&key, '-'))
                 .value_name(value_name)
                 .action(ArgAction::Set)
                 .allow_hyphen_values(true)
