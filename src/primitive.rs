@@ -283,18 +283,18 @@ const DOME_SLOPE: f64 = 0.176_326_980_708_464_98;
 
 impl Shaped {
     /// Is this a dome seen from below (a tree crown's underside), not a
-    /// surface? Its normal, turned towards the sensor, points down, its
-    /// points lie above the sensor on average, and they bend: a quadric
-    /// about their centre (the distance off the plane as `a x^2 + b x y +
-    /// c y^2` plus a constant) explains more than half of their spread off
-    /// the plane, and its normal turns by more than 20 degrees across them
-    /// (twice the 90th percentile of its slope over the points). A plane slab cut from a crown's underside
-    /// passes every other test: its points fill the slab's lower half
-    /// evenly enough to be smooth and its patches lean less than 15
-    /// degrees. A real surface seen from below (a ceiling, an awning) is
-    /// flat; a car's body, which bends as much, is seen from above or from
-    /// the side. `origin` and `pts` are what [`shape`] was given; large
-    /// supports are judged on an even-strided subsample of 20,000 points.
+    /// surface? Its normal, turned towards the sensor, points down, its points
+    /// lie above the sensor on average, and they bend: a quadric about their
+    /// centre (the distance off the plane as `a x^2 + b x y + c y^2` plus a
+    /// constant) explains more than half of their spread off the plane, and its
+    /// normal turns by more than 20 degrees across them (twice the 90th
+    /// percentile of its slope over the points). A plane slab cut from a
+    /// crown's underside passes every other test: its points fill the slab's
+    /// lower half evenly enough to be smooth and its patches lean less than 15
+    /// degrees. A real surface seen from below (a ceiling, an awning) is flat;
+    /// a car's body, which bends as much, is seen from above or from the side.
+    /// `origin` and `pts` are what [`shape`] was given; large supports are
+    /// judged on an even-strided subsample of 20,000 points.
     pub fn domed(&self, origin: DVec3, pts: &[Vec3], viewpoint: DVec3) -> bool {
         let f = &self.primitive.frame;
         if f.normal.z >= 0.0 {
