@@ -9,7 +9,9 @@
 //!    the polygon by a step, take the points inside, re-outline"; here the
 //!    fixed point is computed directly: the gated points are clustered with
 //!    tolerance `along` (linear time) and every cluster that has a point
-//!    within `along` of the outline is taken whole. With convex outlines the
+//!    within `along` of the outline is taken whole, unless it fills the gate
+//!    evenly (a slab of a volume, such as a tree beside a car's end: see
+//!    [`SLAB_RMS`]). With convex outlines the
 //!    paper's extra reach is kept: the hull of old outline and taken points
 //!    is grown again until it takes nothing new.
 //! 3. *Refit* from running moments (only points within three residual
@@ -38,6 +40,7 @@ pub(crate) struct Scratch {
     clusterer: Clusterer,
     cand: Vec<u32>,
     q: Vec<DVec2>,
+    off: Vec<f32>,
 }
 
 /// Grow `prim` with the live points of `cloud`; marks taken points dead in
@@ -69,9 +72,15 @@ pub(crate) fn expand(
 
     // 1. Perpendicular gate, over the voxels near the plane in the box; the
     //    box is enlarged while the growth reaches its edge.
-    let Scratch { clusterer, cand, q } = scratch;
+    let Scratch {
+        clusterer,
+        cand,
+        q,
+        off,
+    } = scratch;
     cand.clear();
     q.clear();
+    off.clear();
     let mut taken: Vec<bool>;
     let mut inner: Vec<bool>;
     let mut outside: bool;
@@ -84,15 +93,25 @@ pub(crate) fn expand(
                     continue;
                 }
                 let p = cloud.points[i as usize];
-                if (nf.dot(p) + df).abs() >= af {
+                let d = nf.dot(p) + df;
+                if d.abs() >= af {
                     continue;
                 }
                 cand.push(i);
+                off.push(d);
                 q.push(prim.frame.to_local(cloud.origin + p.as_dvec3()));
             }
         });
         // 2. Longitudinal growth.
-        (taken, inner, outside) = grow(&prim.outline, q, along, params, clusterer);
+        (taken, inner, outside) = grow(
+            &prim.outline,
+            q,
+            off,
+            SLAB_RMS * across,
+            along,
+            params,
+            clusterer,
+        );
         // Does the taken region reach the edge of the gathered box?
         let mut tlo = DVec3::splat(f64::INFINITY);
         let mut thi = DVec3::splat(f64::NEG_INFINITY);
@@ -158,6 +177,16 @@ pub(crate) fn expand(
     count
 }
 
+/// Clusters of at least this many gated points beyond the outline are
+/// judged by their spread across the gate.
+const SLAB_MIN_POINTS: usize = 20;
+
+/// The RMS distance from the plane, as a share of the gate's half-width,
+/// above which a cluster beyond the outline is a slab of a volume: points
+/// spread evenly across the gate have sqrt(1/3) = 0.577 of it, a surface's
+/// points (the gate is three times the primitive's own RMS) about 1/3.
+const SLAB_RMS: f64 = 0.5;
+
 /// Which of the points `q` are taken: every point within `along` of the
 /// region (the outline, then for convex outlines the hull of outline and
 /// taken points), and every point chained to those through gaps of at most
@@ -173,6 +202,8 @@ pub(crate) fn expand(
 fn grow(
     outline: &[DVec2],
     q: &[DVec2],
+    off: &[f32],
+    max_rms: f64,
     along: f64,
     params: &Params,
     clusterer: &mut Clusterer,
@@ -219,6 +250,19 @@ fn grow(
             let mut hit = vec![false; sizes.len()];
             for &r in &ring {
                 hit[comp[r as usize] as usize] = true;
+            }
+            // A cluster that fills the gate evenly is a slab of a volume
+            // (a tree beside a car's end), not more of the surface.
+            let mut sum = vec![0.0f64; sizes.len()];
+            for (j, &c) in comp.iter().enumerate() {
+                let d = f64::from(off[near_idx[j] as usize]);
+                sum[c as usize] += d * d;
+            }
+            for (c, h) in hit.iter_mut().enumerate() {
+                let n = sizes[c] as usize;
+                if *h && n >= SLAB_MIN_POINTS && sum[c] > max_rms * max_rms * n as f64 {
+                    *h = false;
+                }
             }
             for (j, &c) in comp.iter().enumerate() {
                 if hit[c as usize] {
