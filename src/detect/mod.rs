@@ -431,13 +431,10 @@ impl<'p> Detector<'p> {
                     // rest of the cluster stays in play.
                     let mut layer: Option<round::Candidate> = None;
                     if policy.split_rough_layers && judged.only_too_rough {
-                        if let Some((near, again)) = judge.dominant_layer(&judged, support_pts) {
-                            let (mut c, mut q) = (Vec::new(), Vec::new());
-                            for &i in &near {
-                                c.push(cluster[i]);
-                                q.push(support_pts[i]);
-                            }
-                            layer = Some((c, q));
+                        if let Some((near, again)) =
+                            judge.dominant_layer(&judged, cluster, support_pts)
+                        {
+                            layer = Some(near);
                             judged = again;
                         }
                     }
@@ -457,20 +454,11 @@ impl<'p> Detector<'p> {
                             .map_or((&cluster[..], &support_pts[..]), |(c, s)| (c, s));
                         let normal = judged.shaped.as_ref().map(|s| s.primitive.plane.normal);
                         let spread = scattered_spread(&mut accepted_rms, p);
-                        // In `cluster`'s order: a subsequence of it.
                         let off = normal.map_or_else(Vec::new, |n| {
                             pool.off_crossing_surfaces(cluster, n, SCATTERED_MIN_POINTS, spread)
                         });
                         if 2 * off.len() < cluster.len() {
-                            let (mut c, mut q) = (Vec::new(), Vec::new());
-                            for (&v, &w) in cluster.iter().zip(support_pts) {
-                                if off.get(c.len()) == Some(&v) {
-                                    c.push(v);
-                                    q.push(w);
-                                }
-                            }
-                            let own: round::Candidate = (c, q);
-                            let again = judge.judge(&own.1);
+                            let (own, again) = judge.judge_part(cluster, support_pts, &off);
                             if again.accepted {
                                 layer = Some(own);
                                 judged = again;

@@ -453,8 +453,9 @@ impl PlanePool {
         smallest_eigen3(m.covariance()).map(|(l, v)| (l[0], v))
     }
 
-    /// Of `positions` (points of a plane with unit `normal`), those not on
-    /// another surface crossing it: a point is kept out of the answer when
+    /// Of `positions` (points of a plane with unit `normal`), the indices
+    /// in it (ascending) of those not on another surface crossing it: a
+    /// point is kept out of the answer when
     /// its voxel holds at least `min_points` live points (and 4), they lie
     /// on a plane of their own within `max_spread` (RMS, m), and that
     /// plane is more than [`CROSSING_ANGLE`] degrees off `normal`.
@@ -466,12 +467,12 @@ impl PlanePool {
         normal: DVec3,
         min_points: usize,
         max_spread: f64,
-    ) -> Vec<u32> {
+    ) -> Vec<usize> {
         let max_var = max_spread * max_spread;
         let cos_max = CROSSING_ANGLE.to_radians().cos();
         let mut last: Option<(u32, bool)> = None;
         let mut out = Vec::with_capacity(positions.len());
-        for &pos in positions {
+        for (i, &pos) in positions.iter().enumerate() {
             let c = self.cell_of[pos as usize];
             let crossing = match last {
                 Some((lc, v)) if lc == c => v,
@@ -486,7 +487,7 @@ impl PlanePool {
                 }
             };
             if !crossing {
-                out.push(pos);
+                out.push(i);
             }
         }
         out
@@ -507,7 +508,11 @@ impl PlanePool {
         min_points: usize,
         max_spread: f64,
     ) -> usize {
-        let doomed = self.off_crossing_surfaces(positions, plane.normal, min_points, max_spread);
+        let doomed: Vec<u32> = self
+            .off_crossing_surfaces(positions, plane.normal, min_points, max_spread)
+            .into_iter()
+            .map(|i| positions[i])
+            .collect();
         if doomed.len() < positions.len() {
             self.set_aside
                 .push((plane.normal, plane.offset, plane.threshold));
@@ -1048,7 +1053,7 @@ mod tests {
         let doomed: Vec<usize> = pool
             .off_crossing_surfaces(&inliers, DVec3::Z, 8, 0.02)
             .iter()
-            .map(|&v| pool.original(v) as usize)
+            .map(|&i| pool.original(inliers[i]) as usize)
             .collect();
         let count = |r: std::ops::Range<usize>| doomed.iter().filter(|&&i| r.contains(&i)).count();
         let in_slab =

@@ -180,17 +180,34 @@ impl Judge<'_> {
         }
     }
 
-    /// A candidate that failed only roughness ([`Judged::only_too_rough`]),
-    /// judged again as the layer that holds more of its points, when its
-    /// points lie in two layers ([`two_layers`]): the points within the
-    /// inlier distance of that layer's plane. `Some((positions in
-    /// support_pts, judged))` when the layer is accepted; the rest of the
-    /// candidate stays in play.
+    /// The part of a candidate (`cluster`, `support_pts`) at `at`
+    /// (ascending indices in it), and its judgement.
+    pub(crate) fn judge_part(
+        &self,
+        cluster: &[u32],
+        support_pts: &[Vec3],
+        at: &[usize],
+    ) -> (Candidate, Judged) {
+        let part: Candidate = (
+            at.iter().map(|&i| cluster[i]).collect(),
+            at.iter().map(|&i| support_pts[i]).collect(),
+        );
+        let judged = self.judge(&part.1);
+        (part, judged)
+    }
+
+    /// A candidate (`cluster`, `support_pts`) that failed only roughness
+    /// ([`Judged::only_too_rough`]), judged again as the layer that holds
+    /// more of its points, when its points lie in two layers
+    /// ([`two_layers`]): the points within the inlier distance of that
+    /// layer's plane. `Some((layer, judged))` when the layer is accepted;
+    /// the rest of the candidate stays in play.
     pub(crate) fn dominant_layer(
         &self,
         rough: &Judged,
+        cluster: &[u32],
         support_pts: &[Vec3],
-    ) -> Option<(Vec<usize>, Judged)> {
+    ) -> Option<(Candidate, Judged)> {
         let s = rough.shaped.as_ref()?;
         let world: Vec<DVec3> = support_pts
             .iter()
@@ -208,9 +225,8 @@ impl Judge<'_> {
         if near.len() < self.p.min_inliers || near.len() == world.len() {
             return None;
         }
-        let pts: Vec<Vec3> = near.iter().map(|&i| support_pts[i]).collect();
-        let again = self.judge(&pts);
-        again.accepted.then_some((near, again))
+        let (layer, again) = self.judge_part(cluster, support_pts, &near);
+        again.accepted.then_some((layer, again))
     }
 }
 
