@@ -102,9 +102,8 @@ pub struct CascadePolicy {
     /// cars' roofs and the road beside their feet hold a slab at 48 degrees
     /// that passes every other test. A roof seen at a grazing angle, whose
     /// candidate holds the top rows of the car's sides, keeps its own
-    /// points. Off in one-shot detection for now (BENCHMARKS.md: it makes
-    /// the one-shot more precise than the scenario's map by more than
-    /// `tests/scenario.rs` allows).
+    /// points. Off in one-shot detection for now: measured there on
+    /// quality (BENCHMARKS.md, more precise), not yet on speed.
     ///
     /// [`spare_crossing_surfaces`]: CascadePolicy::spare_crossing_surfaces
     pub judge_without_crossing_bands: bool,
