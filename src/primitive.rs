@@ -280,21 +280,30 @@ impl Shaped {
 /// them), for [`Shaped::domed`].
 const DOME_EXPLAINED: f64 = 0.5;
 const DOME_SLOPE: f64 = 0.176_326_980_708_464_98;
+/// The cosines of 15 and 75 degrees: a plane seen from below and tilted
+/// between them from level is a slant cut through a crown's underside
+/// ([`Shaped::domed`]).
+const SLANT_COS: (f64, f64) = (0.965_925_826_289_068_3, 0.258_819_045_102_520_8);
 
 impl Shaped {
     /// Is this a dome seen from below (a tree crown's underside), not a
     /// surface? Its normal, turned towards the sensor, points down, its points
-    /// lie above the sensor on average, and they bend: a quadric about their
+    /// lie above the sensor on average, and either the plane is slanted
+    /// (tilted between 15 and 75 degrees from level, [`SLANT_COS`]) or its
+    /// points bend: a quadric about their
     /// centre (the distance off the plane as `a x^2 + b x y + c y^2` plus a
     /// constant) explains more than half of their spread off the plane, and its
     /// normal turns by more than 20 degrees across them (twice the 90th
     /// percentile of its slope over the points). A plane slab cut from a
     /// crown's underside passes every other test: its points fill the slab's
     /// lower half evenly enough to be smooth and its patches lean less than 15
-    /// degrees. A real surface seen from below (a ceiling, an awning) is flat;
-    /// a car's body, which bends as much, is seen from above or from the side.
-    /// `origin` and `pts` are what [`shape`] was given; large supports are
-    /// judged on an even-strided subsample of 20,000 points.
+    /// degrees. A real surface seen from below is flat and level (a ceiling,
+    /// an awning) or upright (a wall's overhang); a slant cut through the
+    /// points a crown's underside leaves over many scans need not bend the
+    /// way a quadric explains; a car's body, which bends as much, is seen
+    /// from above or from the side. `origin` and `pts` are what [`shape`] was
+    /// given; large supports are judged on an even-strided subsample of
+    /// 20,000 points.
     pub fn domed(&self, origin: DVec3, pts: &[Vec3], viewpoint: DVec3) -> bool {
         let f = &self.primitive.frame;
         if f.normal.z >= 0.0 {
@@ -318,6 +327,9 @@ impl Shaped {
             / n;
         if height <= viewpoint.z {
             return false;
+        }
+        if -f.normal.z < SLANT_COS.0 && -f.normal.z > SLANT_COS.1 {
+            return true;
         }
         let mid = chosen.iter().fold(DVec2::ZERO, |m, &i| m + self.q[i]) / n;
         // (offset from the centre, distance off the plane)
@@ -629,6 +641,22 @@ mod tests {
             q.z -= 2.0;
         }
         assert!(!judge(&low, DVec3::new(3.0, 0.0, 1.8)));
+        // A flat patch seen from below: slanted 30 degrees (a cut through
+        // a crown's underside), or 10 (an awning, level within 15), or
+        // upright (a wall's overhang).
+        let tilted = |deg: f64| -> Vec<Vec3> {
+            let (s, c) = deg.to_radians().sin_cos();
+            underside(None)
+                .iter()
+                .map(|q| {
+                    let x = f64::from(q.x);
+                    Vec3::new((x * c) as f32, q.y, (2.5 + x * s) as f32)
+                })
+                .collect()
+        };
+        assert!(judge(&tilted(30.0), below), "a slant");
+        assert!(!judge(&tilted(10.0), below), "an awning");
+        assert!(!judge(&tilted(88.0), below), "upright");
     }
 
     #[test]
