@@ -338,7 +338,7 @@ impl Params {
             merge_angle: 8.0,
             merge_distance: 0.08,
             merge_gap: 0.3,
-            pool_scans: 10,
+            pool_scans: 20,
             pool_voxel: 0.1,
             pool_max_points: 100_000,
         }
