@@ -164,7 +164,7 @@ options! {
     /// scan (a far facade, the end of a car, a curb, a ramp at grazing
     /// range) is found once its points add up. 0 turns the pool off (each
     /// scan's detection sees its own leftovers, as in the paper). Default
-    /// 10.
+    /// 20.
     pool_scans: usize = pool_scans, "scans", Check::Count(0, 10_000);
     /// Voxel side of the pool (m): it keeps one point a voxel, the newest,
     /// in a grid anchored at the world origin. Default 0.1.
