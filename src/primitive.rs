@@ -290,20 +290,19 @@ impl Shaped {
     /// surface? Its normal, turned towards the sensor, points down, its points
     /// lie above the sensor on average, and either the plane is slanted
     /// (tilted between 15 and 75 degrees from level, [`SLANT_COS`]) or its
-    /// points bend: a quadric about their
-    /// centre (the distance off the plane as `a x^2 + b x y + c y^2` plus a
-    /// constant) explains more than half of their spread off the plane, and its
-    /// normal turns by more than 20 degrees across them (twice the 90th
-    /// percentile of its slope over the points). A plane slab cut from a
-    /// crown's underside passes every other test: its points fill the slab's
-    /// lower half evenly enough to be smooth and its patches lean less than 15
-    /// degrees. A real surface seen from below is flat and level (a ceiling,
-    /// an awning) or upright (a wall's overhang); a slant cut through the
-    /// points a crown's underside leaves over many scans need not bend the
-    /// way a quadric explains; a car's body, which bends as much, is seen
-    /// from above or from the side. `origin` and `pts` are what [`shape`] was
-    /// given; large supports are judged on an even-strided subsample of
-    /// 20,000 points.
+    /// points bend: a quadric about their centre (the distance off the plane
+    /// as `a x^2 + b x y + c y^2` plus a constant) explains more than half of
+    /// their spread off the plane, and its normal turns by more than 20
+    /// degrees across them (twice the 90th percentile of its slope over the
+    /// points). A plane slab cut from a crown's underside passes every other
+    /// test: its points fill the slab's lower half evenly enough to be smooth
+    /// and its patches lean less than 15 degrees. A real surface seen from
+    /// below is level (a ceiling, an awning) or upright (a wall's overhang).
+    /// A slant cut through what the pool gathers of a crown's underside over
+    /// many scans need not bend the way a quadric explains. A car's body,
+    /// which bends as much, is seen from above or from the side. `origin` and
+    /// `pts` are what [`shape`] was given; large supports are judged on an
+    /// even-strided subsample of 20,000 points.
     pub fn domed(&self, origin: DVec3, pts: &[Vec3], viewpoint: DVec3) -> bool {
         let f = &self.primitive.frame;
         if f.normal.z >= 0.0 {
