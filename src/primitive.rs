@@ -92,7 +92,13 @@ impl Primitive {
     /// `min_width`, solidity? (Detection also tests the support's roughness,
     /// which needs the points.)
     pub fn acceptable(&self, params: &Params) -> bool {
-        self.support >= params.min_inliers as u64
+        self.acceptable_with(params, params.min_inliers)
+    }
+
+    /// [`Primitive::acceptable`] with `min_support` support points instead
+    /// of `min_inliers`.
+    pub(crate) fn acceptable_with(&self, params: &Params, min_support: usize) -> bool {
+        self.support >= min_support as u64
             && self.area >= params.min_area
             && min_width(&self.outline) >= params.min_width
             && match params.solidity {

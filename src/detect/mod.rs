@@ -332,6 +332,14 @@ impl<'p> Detector<'p> {
             ground,
         } = seen;
         let (p, policy) = (self.params, &self.policy);
+        // The least support of a plane and a candidate: by policy, that of
+        // the pool's thinned points (the judge keeps `minInliers` for
+        // near-horizontal candidates at ground depth).
+        let min_support = if policy.pool_support {
+            policy::pool_support(p)
+        } else {
+            p.min_inliers
+        };
         let t0 = clock::now_ms();
         let local_viewpoint = viewpoint - origin;
         let mut pool = PlanePool::new(
@@ -369,6 +377,7 @@ impl<'p> Detector<'p> {
             ground,
             p,
             policy,
+            min_support,
         };
         for _ in 0..4 * p.max_primitives + 64 {
             if !cleared && rejections >= p.max_rejections {
@@ -392,7 +401,9 @@ impl<'p> Detector<'p> {
                 ..CascadeStep::default()
             };
             // 1. RANSAC: the plane with the largest consensus, or stop.
-            let Some((plane, inliers, coords)) = pool.best_plane(p, local_viewpoint, ground) else {
+            let Some((plane, inliers, coords)) =
+                pool.best_plane(p, min_support, local_viewpoint, ground)
+            else {
                 break;
             };
             step.inliers = inliers.len();
@@ -400,7 +411,7 @@ impl<'p> Detector<'p> {
             let clusters =
                 round::cluster_inliers(&mut clusterer, &plane, &coords, local_viewpoint, p, policy);
             step.cluster = clusters.largest_size();
-            if step.cluster < p.min_inliers {
+            if step.cluster < min_support {
                 // No connected patch of this plane is large enough to be a
                 // primitive: its inliers are scattered clutter (a plane
                 // slicing through trees and cars). Take them all out of play

@@ -540,10 +540,11 @@ impl PlanePool {
     pub(crate) fn best_plane(
         &mut self,
         params: &Params,
+        min_support: usize,
         viewpoint: DVec3,
         ground: GroundRule,
     ) -> Option<(LocalPlane, Vec<u32>, Vec<Vec3>)> {
-        if self.remaining() < params.min_inliers.max(3) {
+        if self.remaining() < min_support.max(3) {
             return None;
         }
         // A scoring subset of a big cloud thins out as planes leave; draw a
@@ -635,7 +636,7 @@ impl PlanePool {
             }
         }
         let (inliers, coords) = self.collect(&plane);
-        if inliers.len() < params.min_inliers.max(3) {
+        if inliers.len() < min_support.max(3) {
             return None;
         }
         Some((plane, inliers, coords))
@@ -1110,6 +1111,7 @@ mod tests {
             }
             pool.best_plane(
                 &params,
+                params.min_inliers,
                 DVec3::new(5.0, 5.0, 20.0),
                 GroundRule::BelowViewpoint,
             );

@@ -145,11 +145,16 @@ pub(crate) struct Judge<'a> {
     pub(crate) ground: GroundRule<'a>,
     pub(crate) p: &'a Params,
     pub(crate) policy: &'a CascadePolicy,
+    /// The least support of a candidate: `minInliers`, or with
+    /// [`CascadePolicy::pool_support`] the pool's, except for
+    /// near-horizontal candidates at ground depth below the sensor.
+    pub(crate) min_support: usize,
 }
 
 impl Judge<'_> {
-    /// PCA refit, frame, outline, then the acceptance tests: area, width
-    /// and solidity
+    /// PCA refit, frame, outline, then the acceptance tests: support
+    /// (`min_support`, and `minInliers` near-horizontal at ground depth),
+    /// area, width and solidity
     /// ([`Primitive::acceptable`](crate::primitive::Primitive::acceptable)),
     /// roughness, not a plane seen edge-on, not a dome seen from below (by
     /// policy), normal consistency.
@@ -164,7 +169,8 @@ impl Judge<'_> {
             self.policy.bridge_ring_gaps,
         );
         let rest_ok = |s: &Shaped| {
-            s.primitive.acceptable(p)
+            s.primitive.acceptable_with(p, self.min_support)
+                && !(s.primitive.support < p.min_inliers as u64 && self.at_ground_depth(s))
                 && !(self.policy.reject_edge_on_candidates && seen_edge_on(s, viewpoint, p))
                 && !(self.policy.reject_domes && s.domed(self.origin, support_pts, viewpoint))
                 && s.consistency(self.origin, support_pts, p) >= p.min_normal_consistency
@@ -178,6 +184,14 @@ impl Judge<'_> {
             accepted: smooth && rest,
             only_too_rough: !smooth && rest,
         }
+    }
+
+    /// Is a candidate near-horizontal (within `groundMaxTilt`) with the
+    /// centroid of its fit at least `groundDepth` below the sensor?
+    fn at_ground_depth(&self, s: &Shaped) -> bool {
+        let p = self.p;
+        s.primitive.plane.normal.z.abs() >= libm::cos(p.ground_max_tilt.to_radians())
+            && self.viewpoint.z - s.primitive.moments.mean().z >= p.ground_depth
     }
 
     /// The part of a candidate (`cluster`, `support_pts`) at `at`

@@ -33,8 +33,11 @@ options! {
     /// pose instead.
     viewpoint: Option<[f64; 3]> = viewpoint, "m", Check::FiniteOrNull;
     /// Fewest inliers a plane needs, and fewest support points a primitive
-    /// needs; the cascade stops when the best plane has fewer. gpp2 default
-    /// 150, gpp1 400.
+    /// needs; the cascade stops when the best plane has fewer. The
+    /// scenario's detection on its pool asks for fewer where that holds
+    /// fewer points: what a `minArea` polygon holds at `minOccupancy` of
+    /// the pool's grid (75 by default), except for near-horizontal planes
+    /// well below the sensor. gpp2 default 150, gpp1 400.
     min_inliers: usize = min_inliers, "", Check::Count(3, 100_000_000);
     /// Most plane hypotheses scored per round of one-shot detection (a
     /// bound on work); the scenario's detection on each scan's leftover

@@ -312,7 +312,12 @@ impl Scenario {
         report.sent_to_detection = selection.from_scan;
         report.pool_to_detection = rest.len() - selection.from_scan;
         let pts: Vec<glam::Vec3> = rest.iter().map(|&i| cloud.points[i as usize]).collect();
-        let det = Detector::new(p, CascadePolicy::scenario_leftovers()).run_with_rng(
+        let policy = if report.pool_to_detection > 0 {
+            CascadePolicy::scenario_leftovers().pooled()
+        } else {
+            CascadePolicy::scenario_leftovers()
+        };
+        let det = Detector::new(p, policy).run_with_rng(
             &pts,
             cloud.origin,
             sensor,
