@@ -1152,8 +1152,8 @@ fn expansion_takes_more_of_a_surface_not_a_slice_of_a_volume() {
 /// A 4.5 x 1.2 m surface (a car's side, or the same patch laid flat on
 /// the ground) seen from a sensor standing still at the origin, a little
 /// of it in each scan: `per_scan` new random points, 1 cm of noise. The
-/// scans after which a primitive lies on it (its normal within 10 degrees,
-/// its centroid within 0.1 m of its plane).
+/// scans after which a primitive lies on it (its normal within 10 degrees
+/// of the surface's, the surface's centre within 0.1 m of its plane).
 fn sparse_surface_found_after(upright: bool, scans: usize, per_scan: usize) -> Vec<usize> {
     use polyscene::internals::Rng;
     let mut rng = Rng::new(5);
@@ -1189,7 +1189,7 @@ fn sparse_surface_found_after(upright: bool, scans: usize, per_scan: usize) -> V
 
 /// The pool thins what it keeps to one point a 0.1 m voxel, so a surface
 /// of `minArea` holds at most 150 points there: a far car side seen a few
-/// rings at a time never gathers `minInliers` (150) in the pool, and the
+/// rings at a time may never gather `minInliers` (150) in the pool, and the
 /// scenario's detection on it asks for what a `minArea` polygon holds on
 /// that grid at `minOccupancy` (75) instead. Near the ground it still asks
 /// for `minInliers`: far ground is laser rings seen at a grazing angle,
