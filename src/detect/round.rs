@@ -146,8 +146,9 @@ pub(crate) struct Judge<'a> {
     pub(crate) p: &'a Params,
     pub(crate) policy: &'a CascadePolicy,
     /// The least support of a candidate: `minInliers`, or with
-    /// [`CascadePolicy::pool_support`] the pool's, except for
-    /// near-horizontal candidates at ground depth below the sensor.
+    /// [`CascadePolicy::pool_support`] the pool's (near-horizontal
+    /// candidates at ground depth below the sensor still need
+    /// `minInliers`, see [`Judge::judge`]).
     pub(crate) min_support: usize,
 }
 
@@ -170,6 +171,8 @@ impl Judge<'_> {
         );
         let rest_ok = |s: &Shaped| {
             s.primitive.acceptable_with(p, self.min_support)
+                // (Only the pool's smaller least support lets such a
+                // candidate through to here.)
                 && !(s.primitive.support < p.min_inliers as u64 && self.at_ground_depth(s))
                 && !(self.policy.reject_edge_on_candidates && seen_edge_on(s, viewpoint, p))
                 && !(self.policy.reject_domes && s.domed(self.origin, support_pts, viewpoint))
@@ -186,12 +189,18 @@ impl Judge<'_> {
         }
     }
 
-    /// Is a candidate near-horizontal (within `groundMaxTilt`) with the
-    /// centroid of its fit at least `groundDepth` below the sensor?
+    /// Is a candidate ground by detection's ground test
+    /// ([`Plane::is_ground_below`](crate::geometry::Plane::is_ground_below))
+    /// judged where it lies, under the sensor's height at the centroid of
+    /// its fit rather than under the sensor (a plane a few degrees off
+    /// level, far from the sensor, passes metres above or below it)?
     fn at_ground_depth(&self, s: &Shaped) -> bool {
-        let p = self.p;
-        s.primitive.plane.normal.z.abs() >= libm::cos(p.ground_max_tilt.to_radians())
-            && self.viewpoint.z - s.primitive.moments.mean().z >= p.ground_depth
+        let (p, c) = (self.p, s.primitive.moments.mean());
+        let above = DVec3::new(c.x, c.y, self.viewpoint.z);
+        let min_cos = libm::cos(p.ground_max_tilt.to_radians());
+        s.primitive
+            .plane
+            .is_ground_below(above, min_cos, p.ground_depth)
     }
 
     /// The part of a candidate (`cluster`, `support_pts`) at `at`
