@@ -437,19 +437,33 @@ fn normal_consistency(
     }
 }
 
+/// The rules of [`shape`] that differ between detection's uses, as its
+/// cascade policy (`CascadePolicy`, module `detect`) sets them; the default
+/// has neither.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct ShapeRules {
+    /// Ground footprints fill the gaps between laser rings that the
+    /// range-pulled clustering bridged.
+    pub(crate) bridge_ring_gaps: bool,
+    /// Concave outlines leave out the holes of `minArea` or more.
+    pub(crate) cut_holes: bool,
+}
+
 /// PCA refit, frame, footprint, outline and area of a support set given in
 /// local coordinates relative to `origin`. `None` for degenerate sets (fewer
 /// than three points, collinear) or when no outline exists. With
-/// `ring_gaps` (one-shot detection, whose ground clustering grows with
-/// range), a ground footprint also fills the gaps between laser rings that
-/// the clustering bridged ([`Footprint::bridge_towards`]).
+/// `rules.bridge_ring_gaps` (one-shot detection, whose ground clustering
+/// grows with range), a ground footprint also fills the gaps between laser
+/// rings that the clustering bridged ([`Footprint::bridge_towards`]); with
+/// `rules.cut_holes`, the outline leaves out the holes of `minArea` or
+/// more.
 pub(crate) fn shape(
     origin: DVec3,
     pts: &[Vec3],
     params: &Params,
     viewpoint: DVec3,
     ground: GroundRule,
-    ring_gaps: bool,
+    rules: ShapeRules,
 ) -> Option<Shaped> {
     // World coordinates, once: every pass below reads them.
     let world: Vec<DVec3> = pts.iter().map(|p| origin + p.as_dvec3()).collect();
@@ -485,7 +499,7 @@ pub(crate) fn shape(
     let cell = surface.cell;
     let mut footprint = Footprint::new(cell);
     footprint.mark_all(&q_near);
-    if ground && ring_gaps {
+    if ground && rules.bridge_ring_gaps {
         footprint.bridge_towards(
             frame.to_local(viewpoint),
             params.ground_cluster_range,
@@ -500,6 +514,11 @@ pub(crate) fn shape(
         alpha,
         params.simplify,
         params.max_vertices,
+        if rules.cut_holes {
+            params.min_area
+        } else {
+            f64::INFINITY
+        },
     )?;
     // The method's region, if any, decides which points near the plane stay.
     let kept: Vec<bool> = match &region {
@@ -626,7 +645,7 @@ mod tests {
                 &p,
                 viewpoint,
                 GroundRule::BelowViewpoint,
-                false,
+                ShapeRules::default(),
             )
             .expect("a primitive");
             assert!(s.roughness <= p.max_roughness, "{}", s.roughness);

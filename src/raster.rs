@@ -9,17 +9,75 @@
 /// A traced region: its outer ring (grid corners) and its cells.
 pub(crate) type Traced = (Vec<(i64, i64)>, Vec<bool>);
 
-/// Close `grid` with a disk of radius `r` cells, keep the largest 4-connected
-/// region, fill its holes and trace its outer boundary along cell edges.
-/// Returns the ring in grid-corner coordinates (counter-clockwise: the
-/// region on the left) and the region's cells, one bool per cell.
-pub(crate) fn trace_region(grid: BitGrid, r: usize) -> Option<Traced> {
-    let (w, h) = (grid.w, grid.h);
-    if w == 0 || h == 0 {
-        return None;
+/// A grid closed for tracing: the closing, the exterior of its largest
+/// 4-connected region (the region's holes filled) and how many cells the
+/// region encloses that are not in it.
+pub(crate) struct Closing {
+    closed: BitGrid,
+    outside: Vec<bool>,
+    enclosed: usize,
+}
+
+impl Closing {
+    /// Close `grid` with a disk of radius `r` cells and find its largest
+    /// 4-connected region. `None` when no cell is set.
+    pub(crate) fn new(grid: BitGrid, r: usize) -> Option<Closing> {
+        if grid.w == 0 || grid.h == 0 {
+            return None;
+        }
+        let closed = grid.closed(r);
+        let (outside, enclosed) = exterior_of_largest_region(&closed)?;
+        Some(Closing {
+            closed,
+            outside,
+            enclosed,
+        })
     }
-    let closed = grid.closed(r);
-    let outside = exterior_of_largest_region(&closed)?;
+
+    /// The cells to clear so that each hole of at least `min_hole` cells (a
+    /// 4-connected component of the cells the region encloses that the
+    /// closing left clear) joins the exterior: for each, the region's cells
+    /// on the shortest of four straight walks (down, left, up, right) from
+    /// the hole to the exterior. Empty, at no cost, when the region
+    /// encloses fewer cells.
+    pub(crate) fn cuts(&self, min_hole: usize) -> Vec<u32> {
+        if self.enclosed < min_hole.max(1) {
+            return Vec::new();
+        }
+        keyholes(&self.closed, &self.outside, min_hole.max(1))
+    }
+
+    /// Trace the region with `cuts` made (the other holes filled): its
+    /// outer boundary along cell edges, in grid-corner coordinates
+    /// (counter-clockwise: the region on the left), and its cells, one
+    /// bool per cell, the cut cells among them (a cut leaves no point
+    /// outside the polygon's support). Should the cuts split the region,
+    /// its largest part is traced.
+    pub(crate) fn trace(&self, cuts: &[u32]) -> Option<Traced> {
+        let (w, h) = (self.closed.w, self.closed.h);
+        let recut;
+        let outside = if cuts.is_empty() {
+            &self.outside
+        } else {
+            let mut closed = self.closed.clone();
+            for &k in cuts {
+                closed.clear(k as usize % w, k as usize / w);
+            }
+            recut = exterior_of_largest_region(&closed)?.0;
+            &recut
+        };
+        let ring = trace_ring(outside, w, h)?;
+        let mut inside: Vec<bool> = outside.iter().map(|&o| !o).collect();
+        for &k in cuts {
+            inside[k as usize] = true;
+        }
+        Some((ring, inside))
+    }
+}
+
+/// The outer boundary of the cells not `outside` (a hole-free 4-connected
+/// region) along cell edges, counter-clockwise, in grid-corner coordinates.
+fn trace_ring(outside: &[bool], w: usize, h: usize) -> Option<Vec<(i64, i64)>> {
     let inside = |x: i64, y: i64| -> bool {
         x >= 0
             && y >= 0
@@ -71,15 +129,95 @@ pub(crate) fn trace_region(grid: BitGrid, r: usize) -> Option<Traced> {
             break;
         }
     }
-    let inside_mask = outside.into_iter().map(|o| !o).collect();
-    Some((ring, inside_mask))
+    Some(ring)
+}
+
+/// The cuts of [`Closing::cuts`]: for each hole of the region `!outside`
+/// (a 4-connected component of the cells it encloses that `closed` leaves
+/// clear) of at least `min_hole` cells, the region cells of the straight
+/// walk from the hole's first cell (row-major) to the exterior that
+/// crosses the fewest, in one of the four directions (the first of equally
+/// short ones: down, left, up, right). A walk passes through other holes.
+fn keyholes(closed: &BitGrid, outside: &[bool], min_hole: usize) -> Vec<u32> {
+    let (w, h) = (closed.w, closed.h);
+    const REGION: u8 = 0;
+    const OUT: u8 = 1;
+    const HOLE: u8 = 2;
+    const FOUND: u8 = 3;
+    let mut state: Vec<u8> = (0..w * h)
+        .map(|k| match (outside[k], closed.get(k % w, k / w)) {
+            (true, _) => OUT,
+            (false, true) => REGION,
+            (false, false) => HOLE,
+        })
+        .collect();
+    let mut cuts = Vec::new();
+    for k0 in 0..w * h {
+        if state[k0] != HOLE {
+            continue;
+        }
+        state[k0] = FOUND;
+        let mut cells = vec![k0];
+        let mut i = 0;
+        while let Some(&k) = cells.get(i) {
+            i += 1;
+            for j in neighbours(k, w, h) {
+                if state[j] == HOLE {
+                    state[j] = FOUND;
+                    cells.push(j);
+                }
+            }
+        }
+        if cells.len() < min_hole {
+            continue;
+        }
+        // The region cells a straight walk from (x, y) by (dx, dy) crosses
+        // before the exterior (the grid's border cells are all exterior).
+        let (x, y) = ((k0 % w) as isize, (k0 / w) as isize);
+        let walk = |(dx, dy): (isize, isize)| {
+            let mut cells = Vec::new();
+            let (mut x, mut y) = (x + dx, y + dy);
+            while x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h {
+                let k = y as usize * w + x as usize;
+                match state[k] {
+                    OUT => break,
+                    REGION => cells.push(k as u32),
+                    _ => {}
+                }
+                x += dx;
+                y += dy;
+            }
+            cells
+        };
+        if let Some(cut) = [(0, -1), (-1, 0), (0, 1), (1, 0)]
+            .into_iter()
+            .map(walk)
+            .min_by_key(|c| c.len())
+        {
+            cuts.extend(cut);
+        }
+    }
+    cuts
+}
+
+/// The 4-neighbours of cell `k` of a `w` x `h` grid.
+fn neighbours(k: usize, w: usize, h: usize) -> impl Iterator<Item = usize> {
+    let (x, y) = (k % w, k / w);
+    [
+        (x > 0).then(|| k - 1),
+        (x + 1 < w).then(|| k + 1),
+        (y > 0).then(|| k - w),
+        (y + 1 < h).then(|| k + w),
+    ]
+    .into_iter()
+    .flatten()
 }
 
 /// The cells outside the largest 4-connected region of `closed` (the first
 /// in row-major order of equally large ones) with its holes filled: those
-/// reachable from the grid's border without crossing the region. `None`
-/// when no cell is set.
-fn exterior_of_largest_region(closed: &BitGrid) -> Option<Vec<bool>> {
+/// reachable from the grid's border without crossing the region; and how
+/// many cells it encloses that are not in it. `None` when no cell is set.
+fn exterior_of_largest_region(closed: &BitGrid) -> Option<(Vec<bool>, usize)> {
     let (w, h) = (closed.w, closed.h);
     // Largest 4-connected region (first found wins ties: row-major order),
     // then its holes filled: everything not reachable from the border
@@ -133,15 +271,18 @@ fn exterior_of_largest_region(closed: &BitGrid) -> Option<Vec<bool>> {
         }
     }
     let mut outside = vec![false; w * h];
+    let mut enclosed = 0;
     for y in 0..h {
         for k in gap_start[y] as usize..gap_start[y + 1] as usize {
+            let (x0, x1) = gaps[k];
             if open[gap_root[k] as usize] {
-                let (x0, x1) = gaps[k];
                 outside[y * w + x0 as usize..y * w + x1 as usize].fill(true);
+            } else {
+                enclosed += (x1 - x0) as usize;
             }
         }
     }
-    Some(outside)
+    Some((outside, enclosed))
 }
 
 /// A raster of bits, row by row, each row padded to whole 64-bit words
@@ -190,6 +331,16 @@ impl BitGrid {
             }
         }
         out
+    }
+
+    #[inline]
+    pub(crate) fn get(&self, x: usize, y: usize) -> bool {
+        self.words[y * self.stride + x / 64] >> (x % 64) & 1 == 1
+    }
+
+    #[inline]
+    pub(crate) fn clear(&mut self, x: usize, y: usize) {
+        self.words[y * self.stride + x / 64] &= !(1 << (x % 64));
     }
 
     #[inline]
@@ -571,7 +722,7 @@ mod tests {
             let grid: Vec<bool> = (0..w * h).map(|_| rng.below(100) < fill).collect();
             let expected = region_by_flood_fill(&grid, w, h);
             let got = exterior_of_largest_region(&BitGrid::from_bools(&grid, w, h))
-                .map(|outside| outside.into_iter().map(|o| !o).collect::<Vec<bool>>());
+                .map(|(outside, _)| outside.into_iter().map(|o| !o).collect::<Vec<bool>>());
             if let Some(e) = &expected {
                 holes += (0..w * h).filter(|&k| e[k] && !grid[k]).count();
             }

@@ -37,6 +37,15 @@ pub struct CascadePolicy {
     /// range-pulled clustering bridged, so the outline follows every ring
     /// the clustering joined.
     pub bridge_ring_gaps: bool,
+    /// Concave outlines leave out the holes of `minArea` or more inside
+    /// them, where nothing was seen ([`Footprint::outline_region`](crate::geometry::Footprint::outline_region)):
+    /// one cloud is all there is to see. The scenario's outlines keep them
+    /// filled: a later scan sees into them, and expansion takes points
+    /// only near an outline, so the points seen in a hole went to detection
+    /// and, under a drifting pose, came back as a copy of the surface
+    /// around it (a duplicate pair on the bench's drifting crossing drive,
+    /// seed 1).
+    pub cut_holes: bool,
     /// Every cluster of a round's plane with `minInliers` points is judged,
     /// not only the largest: one plane often holds several surfaces (the
     /// sides of cars parked in a row, the facades along a street). Such a
@@ -180,6 +189,7 @@ impl CascadePolicy {
             hypothesis_scale: 1,
             range_pulled_ground: true,
             bridge_ring_gaps: true,
+            cut_holes: true,
             every_cluster: true,
             reject_edge_on_candidates: true,
             ground: GroundBy::LocalFloor,
@@ -258,6 +268,7 @@ impl CascadePolicy {
             hypothesis_scale: 2,
             range_pulled_ground: false,
             bridge_ring_gaps: false,
+            cut_holes: false,
             every_cluster: false,
             reject_edge_on_candidates: true,
             ground: GroundBy::Viewpoint,

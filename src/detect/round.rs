@@ -8,7 +8,7 @@ use super::viewpoint::{pull_towards, seen_edge_on};
 use crate::floor::GroundRule;
 use crate::geometry::{Frame, Plane};
 use crate::params::Params;
-use crate::primitive::{shape, Shaped};
+use crate::primitive::{shape, ShapeRules, Shaped};
 use glam::{DVec2, DVec3, Vec3};
 
 /// A round's inliers split into connected clusters in their plane.
@@ -167,7 +167,10 @@ impl Judge<'_> {
             p,
             viewpoint,
             self.ground,
-            self.policy.bridge_ring_gaps,
+            ShapeRules {
+                bridge_ring_gaps: self.policy.bridge_ring_gaps,
+                cut_holes: self.policy.cut_holes,
+            },
         );
         let rest_ok = |s: &Shaped| {
             s.primitive.acceptable_with(p, self.min_support)

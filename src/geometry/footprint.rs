@@ -9,10 +9,11 @@
 //! morphologically with a disk of radius `alpha` (dilate, then erode: this is
 //! exactly the complement of the union of all empty disks of radius `alpha`,
 //! i.e. the alpha hull, on the grid), the largest 4-connected region is kept,
-//! its holes are filled, and its boundary is traced along cell edges. A
-//! hole-free 4-connected region of cells has no pinch vertices, so the traced
-//! ring is always a simple polygon; it is then simplified (Douglas–Peucker,
-//! simplicity kept) within a tolerance. Work is linear in the number of cells
+//! its holes are filled, or the large ones joined to the outside by a cut
+//! (see [`Footprint::outline_region`]), and its boundary is traced along cell
+//! edges. A hole-free 4-connected region of cells has no pinch vertices, so
+//! the traced ring is always a simple polygon; it is then simplified
+//! (Douglas–Peucker, simplicity kept) within a tolerance. Work is linear in the number of cells
 //! in the bounding box, independent of the number of points.
 //!
 //! Here: the footprint's storage (marking, counting, bridging, the snapshot
@@ -22,8 +23,10 @@
 //! uses it is [`crate::outline`]. Both outline methods keep a footprint
 //! (occupancy, merging and expansion read it), so it stays here.
 
-use super::polygon::{is_simple, make_ccw, remove_collinear, signed_area, simplify};
-use crate::raster::{trace_region, BitGrid};
+use super::polygon::{
+    is_simple, make_ccw, remove_collinear, signed_area, simplify_raised, simplify_within,
+};
+use crate::raster::{BitGrid, Closing};
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
@@ -461,20 +464,41 @@ impl Footprint {
     }
 
     /// Concave outline (see the module docs): closing radius `alpha` metres,
-    /// simplification `tolerance` metres, at most `max_vertices` vertices.
-    /// Counter-clockwise, simple; `None` when nothing is set.
-    pub fn outline(&self, alpha: f64, tolerance: f64, max_vertices: usize) -> Option<Vec<DVec2>> {
-        self.outline_region(alpha, tolerance, max_vertices)
+    /// simplification `tolerance` metres, at most `max_vertices` vertices,
+    /// holes of at least `min_hole` square metres left out (see
+    /// [`Footprint::outline_region`]). Counter-clockwise, simple; `None` when
+    /// nothing is set.
+    pub fn outline(
+        &self,
+        alpha: f64,
+        tolerance: f64,
+        max_vertices: usize,
+        min_hole: f64,
+    ) -> Option<Vec<DVec2>> {
+        self.outline_region(alpha, tolerance, max_vertices, min_hole)
             .map(|(r, _)| r)
     }
 
     /// [`Footprint::outline`] together with the raster region it traces, to
     /// test which points the outline was made from.
+    ///
+    /// A hole the closing leaves inside the region (no point within `alpha`
+    /// of its cells) of at least `min_hole` square metres is area where
+    /// nothing was seen, and the outline leaves it out: the region is cut
+    /// along the shortest of four straight walks of cells (along the grid's
+    /// axes) from the hole to its edge, and the ring runs in along one side
+    /// of the cut, around the hole and out along the other, a slit two
+    /// cells wide after the half-cell inset. A polygon is one simple ring, and stays so. Only
+    /// an outline that fits `max_vertices` at `tolerance` with its holes
+    /// left out gets them: a hole never costs the outer shape its
+    /// resolution. The region's cells, for the point tests, hold the cuts'
+    /// cells.
     pub fn outline_region(
         &self,
         alpha: f64,
         tolerance: f64,
         max_vertices: usize,
+        min_hole: f64,
     ) -> Option<(Vec<DVec2>, Region)> {
         if self.count() == 0 {
             return None;
@@ -509,10 +533,70 @@ impl Footprint {
                 let gy = (y - ly) / factor + m;
                 self.row_set_cells(y, |x| grid.set((x - lx) / factor + m, gy));
             }
-            let (corners, inside) = trace_region(grid, r)?;
+            let closing = Closing::new(grid, r)?;
             let cs = self.cell * factor as f64;
             let ox = (self.x0 + lx as i64) as f64 * self.cell - m as f64 * cs;
             let oy = (self.y0 + ly as i64) as f64 * self.cell - m as f64 * cs;
+            let ring_of = |corners: Vec<(i64, i64)>| {
+                let mut ring: Vec<DVec2> = corners
+                    .into_iter()
+                    .map(|(x, y)| DVec2::new(ox + x as f64 * cs, oy + y as f64 * cs))
+                    .collect();
+                make_ccw(&mut ring);
+                remove_collinear(&mut ring);
+                if ring.len() < 3 {
+                    return None;
+                }
+                // The traced ring runs along the outer edges of the boundary
+                // cells, half a cell beyond the points on average: move it in
+                // by half a cell (through the boundary cells' centres),
+                // unless that would collapse a one-cell-wide part or, in
+                // rounding, the whole ring: a region one cell wide everywhere
+                // (a curb's face seen along one laser ring) insets to a line,
+                // which rounding left as a ring of area 1e-17 that passes as
+                // simple. An inset that keeps a region keeps at least half a
+                // cell's area (a 2 x 2 block of cells insets to one cell).
+                let inset = inset_rectilinear(&ring, 0.5 * cs);
+                if is_simple(&inset) && signed_area(&inset) >= 0.5 * cs * cs {
+                    ring = inset;
+                }
+                Some(ring)
+            };
+            let tolerance = tolerance.max(0.0);
+            let mut fallback = None;
+            // NaN and negative sizes cut no hole, nor does a hole of no cells.
+            let min_hole = if min_hole >= 0.0 {
+                ((min_hole / (cs * cs)).ceil() as usize).max(1)
+            } else {
+                usize::MAX
+            };
+            // First without cuts; then, if that fits, with them.
+            let mut cuts: Option<Vec<u32>> = None;
+            let (mut out, inside) = loop {
+                let traced = closing
+                    .trace(cuts.as_deref().unwrap_or_default())
+                    .and_then(|(c, i)| Some((ring_of(c)?, i)));
+                let fits = traced
+                    .as_ref()
+                    .and_then(|(r, _)| simplify_within(r, tolerance, max_vertices));
+                match (traced, fits, cuts.is_some()) {
+                    (Some((_, i)), Some(o), false) => {
+                        let c = closing.cuts(min_hole);
+                        if c.is_empty() {
+                            break (o, i);
+                        }
+                        cuts = Some(c);
+                        fallback = Some((o, i));
+                    }
+                    (Some((_, i)), Some(o), true) => break (o, i),
+                    (Some((r, i)), None, false) => {
+                        break (simplify_raised(&r, tolerance, max_vertices), i)
+                    }
+                    (None, _, false) => return None,
+                    _ => break fallback?,
+                }
+            };
+            make_ccw(&mut out);
             let region = Region {
                 inv: 1.0 / self.cell,
                 base: (self.x0 + lx as i64, self.y0 + ly as i64),
@@ -522,30 +606,6 @@ impl Footprint {
                 h: gh,
                 inside,
             };
-            let mut ring: Vec<DVec2> = corners
-                .into_iter()
-                .map(|(x, y)| DVec2::new(ox + x as f64 * cs, oy + y as f64 * cs))
-                .collect();
-            make_ccw(&mut ring);
-            remove_collinear(&mut ring);
-            if ring.len() < 3 {
-                return None;
-            }
-            // The traced ring runs along the outer edges of the boundary cells,
-            // half a cell beyond the points on average: move it in by half a
-            // cell (through the boundary cells' centres), unless that would
-            // collapse a one-cell-wide part or, in rounding, the whole ring:
-            // a region one cell wide everywhere (a curb's face seen along one
-            // laser ring) insets to a line, which rounding left as a ring of
-            // area 1e-17 that passes as simple. An inset that keeps a
-            // region keeps at least half a cell's area (a 2 x 2 block of
-            // cells insets to one cell).
-            let inset = inset_rectilinear(&ring, 0.5 * cs);
-            if is_simple(&inset) && signed_area(&inset) >= 0.5 * cs * cs {
-                ring = inset;
-            }
-            let mut out = simplify(&ring, tolerance.max(0.0), max_vertices);
-            make_ccw(&mut out);
             return Some((out, region));
         }
     }
@@ -641,7 +701,7 @@ fn inset_rectilinear(ring: &[DVec2], d: f64) -> Vec<DVec2> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::polygon::{contains, is_simple, signed_area};
+    use crate::geometry::polygon::{contains, distance, is_simple, signed_area};
 
     #[test]
     fn huge_extents_are_bounded_not_a_crash() {
@@ -662,7 +722,7 @@ mod tests {
         );
         assert_eq!(small.mark_all(&[DVec2::new(1.0, 1.0)]), 1);
         assert!(small.is_set(DVec2::new(1.0, 1.0)));
-        let _ = small.outline(0.5, 0.1, 64);
+        let _ = small.outline(0.5, 0.1, 64, f64::INFINITY);
     }
 
     #[test]
@@ -678,7 +738,7 @@ mod tests {
                 .map(|i| DVec2::new(-26.7565 + 0.0247 * i as f64, y))
                 .collect();
             fp.mark_all(&pts);
-            let ring = fp.outline(0.5, 0.1, 64).unwrap();
+            let ring = fp.outline(0.5, 0.1, 64, f64::INFINITY).unwrap();
             assert!(is_simple(&ring), "{ring:?}");
             assert!(signed_area(&ring) >= 0.039, "{y}: {ring:?}");
         }
@@ -801,7 +861,7 @@ mod tests {
         let pts = grid_points(|x, y| !(x > 5.0 && y > 5.0), 0.1, 101);
         let mut fp = Footprint::new(0.1);
         fp.mark_all(&pts);
-        let ring = fp.outline(0.3, 0.05, 200).unwrap();
+        let ring = fp.outline(0.3, 0.05, 200, f64::INFINITY).unwrap();
         assert!(is_simple(&ring));
         assert!(signed_area(&ring) > 0.0);
         assert!(
@@ -820,9 +880,9 @@ mod tests {
         let pts = grid_points(|_, y| !(2.0..=2.6).contains(&y), 0.05, 100);
         let mut fp = Footprint::new(0.05);
         fp.mark_all(&pts);
-        let joined = fp.outline(0.4, 0.02, 100).unwrap();
+        let joined = fp.outline(0.4, 0.02, 100, f64::INFINITY).unwrap();
         assert!(contains(&joined, DVec2::new(2.0, 2.3)));
-        let split = fp.outline(0.2, 0.02, 100).unwrap();
+        let split = fp.outline(0.2, 0.02, 100, f64::INFINITY).unwrap();
         assert!(!contains(&split, DVec2::new(2.0, 2.3)));
         assert!(is_simple(&split));
     }
@@ -836,9 +896,73 @@ mod tests {
         fp.mark_all(&ring_pts[ring_pts.len() / 2..]);
         assert!(fp.count() > before);
         assert!(fp.is_set(DVec2::new(0.05, 0.05)));
-        let o = fp.outline(0.0, 0.0, 1000).unwrap();
+        let o = fp.outline(0.0, 0.0, 1000, f64::INFINITY).unwrap();
         assert!(contains(&o, DVec2::new(4.5, 4.5)), "hole not filled");
         assert!(is_simple(&o));
+        // A hole smaller than `min_hole` is filled too.
+        assert_eq!(fp.outline(0.0, 0.0, 1000, 10.0).unwrap(), o);
+    }
+
+    #[test]
+    fn a_hole_of_min_hole_or_more_is_left_out_through_a_slit() {
+        // A 9 x 9 m square of points with a 3 x 3 m hole: nothing seen there.
+        let pts = grid_points(|x, y| !(x > 3.0 && x < 6.0 && y > 3.0 && y < 6.0), 0.1, 91);
+        let mut fp = Footprint::new(0.1);
+        fp.mark_all(&pts);
+        for alpha in [0.0, 0.5] {
+            let o = fp.outline(alpha, 0.05, 1000, 5.0).unwrap();
+            assert!(is_simple(&o), "alpha {alpha}: {o:?}");
+            assert!(
+                !contains(&o, DVec2::new(4.5, 4.5)),
+                "alpha {alpha}: hole kept"
+            );
+            // The square (9 m between the outer points' cells' centres) less
+            // the hole (3.1 m a side after the inset) and a slit 0.2 m wide
+            // across the 3 m to the edge; the closing rounds the hole's
+            // corners (alpha 0.5: up to (4 - pi) * 0.25 = 0.21 m^2 back).
+            let a = signed_area(&o);
+            let want = 81.0 - 3.1 * 3.1 - 3.0 * 0.2;
+            assert!(
+                a > want - 0.1 && a < want + 0.5,
+                "alpha {alpha}: {a} against {want}"
+            );
+            // Every point lies on or in the outline but the 30 along the slit.
+            let off = pts.iter().filter(|&&p| distance(&o, p) > 1e-9).count();
+            assert!(off <= 31, "{off} points off the outline");
+        }
+        // The region, for the point tests, holds every point.
+        let (_, region) = fp.outline_region(0.0, 0.05, 1000, 5.0).unwrap();
+        assert!(pts.iter().all(|&p| region.contains(p)));
+    }
+
+    #[test]
+    fn holes_are_cut_only_when_the_outline_keeps_its_resolution() {
+        // A 20 x 4 m strip with five 1 x 1 m holes: cutting them takes about
+        // 45 vertices. In 30 the outer shape would have to coarsen, so none
+        // is cut and the strip keeps its corners.
+        let hole = |x: f64, y: f64| (1.0..2.0).contains(&(x % 4.0)) && y > 1.5 && y < 2.5;
+        let pts: Vec<DVec2> = grid_points(|x, y| y < 4.0 && x < 20.0 && !hole(x, y), 0.1, 201);
+        let mut fp = Footprint::new(0.1);
+        fp.mark_all(&pts);
+        let cut = |o: &[DVec2]| {
+            (0..5)
+                .filter(|&i| !contains(o, DVec2::new(4.0 * i as f64 + 1.5, 2.0)))
+                .count()
+        };
+        let all = fp.outline(0.0, 0.05, 1000, 0.5).unwrap();
+        assert_eq!(cut(&all), 5);
+        assert!(all.len() > 30, "{} vertices", all.len());
+        let few = fp.outline(0.0, 0.05, 30, 0.5).unwrap();
+        assert_eq!(cut(&few), 0);
+        assert_eq!(few, fp.outline(0.0, 0.05, 30, f64::INFINITY).unwrap());
+        for c in [(0.0, 0.0), (20.0, 0.0), (20.0, 4.0), (0.0, 4.0)] {
+            let c = DVec2::new(c.0, c.1);
+            let d = few
+                .iter()
+                .map(|v| v.distance(c))
+                .fold(f64::INFINITY, f64::min);
+            assert!(d < 0.2, "corner {c} is {d} m from the outline's vertices");
+        }
     }
 
     #[test]
@@ -848,8 +972,10 @@ mod tests {
         let mut fp = Footprint::new(1.0);
         fp.mark_all(&pts);
         for alpha in [0.0, 0.5, 1.0, 2.0] {
-            if let Some(o) = fp.outline(alpha, 0.0, 1000) {
-                assert!(is_simple(&o), "alpha {alpha}");
+            for min_hole in [0.0, 1.0, f64::INFINITY] {
+                if let Some(o) = fp.outline(alpha, 0.0, 1000, min_hole) {
+                    assert!(is_simple(&o), "alpha {alpha} min_hole {min_hole}");
+                }
             }
         }
     }

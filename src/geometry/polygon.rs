@@ -241,29 +241,15 @@ pub fn remove_collinear(ring: &mut Vec<DVec2>) {
 /// `tolerance` has few enough vertices but self-intersects, smaller
 /// tolerances are tried first. Last resort: the ring's convex hull.
 pub fn simplify(ring: &[DVec2], tolerance: f64, max_vertices: usize) -> Vec<DVec2> {
-    let n = ring.len();
+    simplify_within(ring, tolerance, max_vertices)
+        .unwrap_or_else(|| simplify_raised(ring, tolerance, max_vertices))
+}
+
+/// The rest of [`simplify`] once [`simplify_within`] found no ring: the
+/// tolerance raised until one fits, or the convex hull.
+pub fn simplify_raised(ring: &[DVec2], tolerance: f64, max_vertices: usize) -> Vec<DVec2> {
     let max_vertices = max_vertices.max(4);
-    if n <= 4 || (n <= max_vertices && tolerance <= 0.0) {
-        return ring.to_vec();
-    }
     let tol = tolerance.max(0.0);
-    let first = dp_closed(ring, tol);
-    if first.len() <= max_vertices && is_simple(&first) {
-        return first;
-    }
-    if first.len() <= max_vertices {
-        let mut t = tol * 0.5;
-        for _ in 0..20 {
-            let out = dp_closed(ring, t);
-            if out.len() > max_vertices {
-                break;
-            }
-            if is_simple(&out) {
-                return out;
-            }
-            t *= 0.5;
-        }
-    }
     let mut t = if tol > 0.0 { tol } else { 1e-3 };
     for _ in 0..80 {
         t *= 1.5;
@@ -283,6 +269,35 @@ pub fn simplify(ring: &[DVec2], tolerance: f64, max_vertices: usize) -> Vec<DVec
             .collect(),
         None => ring.to_vec(),
     }
+}
+
+/// [`simplify`] without raising the tolerance: `None` when the ring needs
+/// a larger tolerance than `tolerance` to fit in `max_vertices` simply.
+pub fn simplify_within(ring: &[DVec2], tolerance: f64, max_vertices: usize) -> Option<Vec<DVec2>> {
+    let n = ring.len();
+    let max_vertices = max_vertices.max(4);
+    if n <= 4 || (n <= max_vertices && tolerance <= 0.0) {
+        return Some(ring.to_vec());
+    }
+    let tol = tolerance.max(0.0);
+    let first = dp_closed(ring, tol);
+    if first.len() <= max_vertices && is_simple(&first) {
+        return Some(first);
+    }
+    if first.len() <= max_vertices {
+        let mut t = tol * 0.5;
+        for _ in 0..20 {
+            let out = dp_closed(ring, t);
+            if out.len() > max_vertices {
+                break;
+            }
+            if is_simple(&out) {
+                return Some(out);
+            }
+            t *= 0.5;
+        }
+    }
+    None
 }
 
 fn dp_closed(ring: &[DVec2], tol: f64) -> Vec<DVec2> {

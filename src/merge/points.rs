@@ -253,7 +253,7 @@ fn absorb(
     out.footprint.mark_all(&marks);
     let (ring, region) = out
         .footprint
-        .outline_region(out.alpha(p), p.simplify, p.max_vertices)
+        .outline_region(out.alpha(p), p.simplify, p.max_vertices, p.min_area)
         .ok_or_else(Vec::new)?;
     let mut kept = Vec::with_capacity(taken.len());
     for &(i, q) in &taken {
@@ -329,7 +329,7 @@ mod tests {
     use super::*;
     use crate::floor::GroundRule;
     use crate::geometry::polygon::distance;
-    use crate::primitive::shape;
+    use crate::primitive::{shape, ShapeRules};
 
     /// Points of a vertical patch in the plane y = `tilt` * z, x in `x0..x1`,
     /// z in 0..2, on a grid of 5 cm shifted by `shift`.
@@ -353,7 +353,15 @@ mod tests {
         let mut prims = Vec::new();
         let mut labels = Vec::new();
         for (id, pts) in patches.iter().enumerate() {
-            let s = shape(DVec3::ZERO, pts, p, view, GroundRule::BelowViewpoint, false).unwrap();
+            let s = shape(
+                DVec3::ZERO,
+                pts,
+                p,
+                view,
+                GroundRule::BelowViewpoint,
+                ShapeRules::default(),
+            )
+            .unwrap();
             assert!(s.kept.iter().all(|&k| k));
             let mut prim = s.primitive;
             prim.id = id as u32;
@@ -388,7 +396,15 @@ mod tests {
         let view = DVec3::new(2.0, -6.0, 1.5);
         let mut prims = Vec::new();
         for (id, (pts, q)) in [(&near, &p), (&far, &coarse)].into_iter().enumerate() {
-            let s = shape(DVec3::ZERO, pts, q, view, GroundRule::BelowViewpoint, false).unwrap();
+            let s = shape(
+                DVec3::ZERO,
+                pts,
+                q,
+                view,
+                GroundRule::BelowViewpoint,
+                ShapeRules::default(),
+            )
+            .unwrap();
             assert!(s.kept.iter().all(|&k| k));
             prims.push(Primitive {
                 id: id as u32,

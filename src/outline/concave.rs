@@ -22,18 +22,21 @@ pub(crate) fn outline(
     alpha: f64,
     tolerance: f64,
     max_vertices: usize,
+    min_hole: f64,
 ) -> Option<(Vec<DVec2>, Region)> {
-    footprint.outline_region(alpha, tolerance, max_vertices)
+    footprint.outline_region(alpha, tolerance, max_vertices, min_hole)
 }
 
-/// The alpha hull of the footprint with the new points' cells marked.
+/// The alpha hull of the footprint with the new points' cells marked, its
+/// holes filled (a grown primitive is the scenario's, whose outlines keep
+/// their holes: `CascadePolicy::cut_holes`).
 pub(crate) fn grown(
     footprint: &Footprint,
     alpha: f64,
     tolerance: f64,
     max_vertices: usize,
 ) -> Option<Vec<DVec2>> {
-    footprint.outline(alpha, tolerance, max_vertices)
+    footprint.outline(alpha, tolerance, max_vertices, f64::INFINITY)
 }
 
 /// Nothing: the merged footprint holds the absorbed primitive's cells.

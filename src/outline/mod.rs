@@ -57,7 +57,8 @@ impl HullKind {
     /// Outline of a new primitive whose support points near the plane are
     /// `points` (frame coordinates) and whose footprint is `footprint`:
     /// closing radius `alpha`, simplification `tolerance` (metres), at most
-    /// `max_vertices` vertices. With the outline, the region of footprint
+    /// `max_vertices` vertices, holes of at least `min_hole` square metres
+    /// left out (concave; see [`Footprint::outline_region`]). With the outline, the region of footprint
     /// cells it was traced from when the method keeps only the points in
     /// it (concave: the largest connected region), `None` when it keeps
     /// them all. `None` when no outline exists.
@@ -68,11 +69,13 @@ impl HullKind {
         alpha: f64,
         tolerance: f64,
         max_vertices: usize,
+        min_hole: f64,
     ) -> Option<(Vec<DVec2>, Option<Region>)> {
         match self {
             HullKind::Convex => Some((convex::outline(points, tolerance, max_vertices)?, None)),
             HullKind::Concave => {
-                let (ring, region) = concave::outline(footprint, alpha, tolerance, max_vertices)?;
+                let (ring, region) =
+                    concave::outline(footprint, alpha, tolerance, max_vertices, min_hole)?;
                 Some((ring, Some(region)))
             }
         }
@@ -157,11 +160,11 @@ mod tests {
             .collect();
         fp.mark_all(&cells);
         let (ring, region) = HullKind::Convex
-            .outline(&square, &fp, 0.5, 0.0, 64)
+            .outline(&square, &fp, 0.5, 0.0, 64, f64::INFINITY)
             .unwrap();
         assert_eq!((ring.len(), region.is_none()), (4, true));
         let (ring, region) = HullKind::Concave
-            .outline(&square, &fp, 0.5, 0.0, 64)
+            .outline(&square, &fp, 0.5, 0.0, 64, f64::INFINITY)
             .unwrap();
         assert!(ring.len() >= 4 && region.unwrap().contains(DVec2::splat(0.5)));
         // Growing: the convex hull from the new points, the concave outline
