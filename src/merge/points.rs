@@ -347,23 +347,21 @@ mod tests {
         out
     }
 
+    /// The primitive shaped from `pts` seen from `view`, every point kept.
+    fn shaped_whole(pts: &[Vec3], p: &Params, view: DVec3) -> Primitive {
+        let rules = ShapeRules::default();
+        let s = shape(DVec3::ZERO, pts, p, view, GroundRule::BelowViewpoint, rules).unwrap();
+        assert!(s.kept.iter().all(|&k| k));
+        s.primitive
+    }
+
     /// Primitives shaped from patches, labelled as detection would.
     fn pieces(patches: &[&[Vec3]], p: &Params) -> (Vec<Primitive>, Vec<u32>, Vec<Vec3>) {
         let view = DVec3::new(2.0, -6.0, 1.5);
         let mut prims = Vec::new();
         let mut labels = Vec::new();
         for (id, pts) in patches.iter().enumerate() {
-            let s = shape(
-                DVec3::ZERO,
-                pts,
-                p,
-                view,
-                GroundRule::BelowViewpoint,
-                ShapeRules::default(),
-            )
-            .unwrap();
-            assert!(s.kept.iter().all(|&k| k));
-            let mut prim = s.primitive;
+            let mut prim = shaped_whole(pts, p, view);
             prim.id = id as u32;
             prims.push(prim);
             labels.extend(std::iter::repeat_n(id as u32, pts.len()));
@@ -396,19 +394,9 @@ mod tests {
         let view = DVec3::new(2.0, -6.0, 1.5);
         let mut prims = Vec::new();
         for (id, (pts, q)) in [(&near, &p), (&far, &coarse)].into_iter().enumerate() {
-            let s = shape(
-                DVec3::ZERO,
-                pts,
-                q,
-                view,
-                GroundRule::BelowViewpoint,
-                ShapeRules::default(),
-            )
-            .unwrap();
-            assert!(s.kept.iter().all(|&k| k));
             prims.push(Primitive {
                 id: id as u32,
-                ..s.primitive
+                ..shaped_whole(pts, q, view)
             });
         }
         assert!(prims[1].footprint.cell() > prims[0].footprint.cell());
