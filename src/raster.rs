@@ -137,13 +137,22 @@ fn trace_ring(outside: &[bool], w: usize, h: usize) -> Option<Vec<(i64, i64)>> {
 /// clear) of at least `min_hole` cells, the region cells of the straight
 /// walk from the hole's first cell (row-major) to the exterior that
 /// crosses the fewest, in one of the four directions (the first of equally
-/// short ones: down, left, up, right). A walk passes through other holes.
+/// short ones: down, left, up, right).
+///
+/// Holes are opened one at a time, and what an earlier cut opened counts
+/// as exterior for the later walks: its cut, its hole, and the holes it
+/// passed through (which need no cut of their own). Each cut joins one
+/// new hole to what is already open, so the cuts form a tree and never
+/// enclose a part of the region: two cuts from one hole to the exterior
+/// would cut off the region between them.
 fn keyholes(closed: &BitGrid, outside: &[bool], min_hole: usize) -> Vec<u32> {
     let (w, h) = (closed.w, closed.h);
     const REGION: u8 = 0;
     const OUT: u8 = 1;
     const HOLE: u8 = 2;
     const FOUND: u8 = 3;
+    // A hole under `min_hole` cells: filled unless a cut passes it.
+    const SMALL: u8 = 4;
     let mut state: Vec<u8> = (0..w * h)
         .map(|k| match (outside[k], closed.get(k % w, k / w)) {
             (true, _) => OUT,
@@ -169,33 +178,61 @@ fn keyholes(closed: &BitGrid, outside: &[bool], min_hole: usize) -> Vec<u32> {
             }
         }
         if cells.len() < min_hole {
+            for &k in &cells {
+                state[k] = SMALL;
+            }
             continue;
         }
         // The region cells a straight walk from (x, y) by (dx, dy) crosses
         // before the exterior (the grid's border cells are all exterior).
         let (x, y) = ((k0 % w) as isize, (k0 / w) as isize);
+        // Its cells and the holes' cells it passes, in order.
         let walk = |(dx, dy): (isize, isize)| {
-            let mut cells = Vec::new();
+            let (mut region, mut holes) = (Vec::new(), Vec::new());
             let (mut x, mut y) = (x + dx, y + dy);
             while x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h {
                 let k = y as usize * w + x as usize;
                 match state[k] {
                     OUT => break,
-                    REGION => cells.push(k as u32),
+                    REGION => region.push(k as u32),
+                    HOLE | SMALL => holes.push(k),
                     _ => {}
                 }
                 x += dx;
                 y += dy;
             }
-            cells
+            (region, holes)
         };
-        if let Some(cut) = [(0, -1), (-1, 0), (0, 1), (1, 0)]
+        let Some((cut, passed)) = [(0, -1), (-1, 0), (0, 1), (1, 0)]
             .into_iter()
             .map(walk)
-            .min_by_key(|c| c.len())
-        {
-            cuts.extend(cut);
+            .min_by_key(|(c, _)| c.len())
+        else {
+            continue;
+        };
+        // Open: the hole, the cut and every hole the cut passes.
+        for &k in &cells {
+            state[k] = OUT;
         }
+        for &k in &cut {
+            state[k as usize] = OUT;
+        }
+        for k0 in passed {
+            if state[k0] == OUT {
+                continue;
+            }
+            state[k0] = OUT;
+            let mut stack = vec![k0];
+            while let Some(k) = stack.pop() {
+                for j in neighbours(k, w, h) {
+                    if matches!(state[j], HOLE | SMALL) {
+                        state[j] = OUT;
+                        stack.push(j);
+                    }
+                }
+            }
+        }
+        cuts.extend(cut);
     }
     cuts
 }
@@ -770,5 +807,39 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn cuts_through_another_hole_cut_nothing_off() {
+        // A wide hole B near the region's bottom edge and a small hole A
+        // above it, whose shortest way out runs down through B. B's own
+        // cut runs down from its first cell: two cuts from B to the edge
+        // used to cut off the strip of region between them.
+        let (w, h) = (60, 60);
+        let hole_a = |x: usize, y: usize| (26..33).contains(&x) && (23..31).contains(&y);
+        let hole_b = |x: usize, y: usize| (10..46).contains(&x) && (8..21).contains(&y);
+        let region = |x: usize, y: usize| {
+            (5..55).contains(&x) && (5..55).contains(&y) && !hole_a(x, y) && !hole_b(x, y)
+        };
+        let mut grid = BitGrid::new(w, h);
+        for y in 0..h {
+            for x in 0..w {
+                if region(x, y) {
+                    grid.set(x, y);
+                }
+            }
+        }
+        let closing = Closing::new(grid, 0).unwrap();
+        let cuts = closing.cuts(20);
+        let t = closing.trace(&cuts).unwrap();
+        for y in 0..h {
+            for x in 0..w {
+                let k = y * w + x;
+                assert_eq!(t.1[k], region(x, y), "cell ({x}, {y})");
+            }
+        }
+        // B opens through the 3 cells below it, A through the 2 between
+        // it and B.
+        assert_eq!(cuts.len(), 5, "{cuts:?}");
     }
 }
