@@ -1161,6 +1161,34 @@ fn a_world_frame_location_without_a_viewpoint_keeps_its_ground() {
     assert!(precision > 0.93, "{precision}");
 }
 
+/// Without a viewpoint, `detect` says what it went by: the origin for a
+/// scan in its own frame (1.8 m above its ground), no sensor for the same
+/// scan moved to map coordinates (read as a map), the viewpoint when given.
+#[test]
+fn detection_reports_the_sensor_it_went_by() {
+    let mut rng = Rng::new(5);
+    let pts: Vec<DVec3> = flat_ground(&mut rng)
+        .into_iter()
+        .map(|q| q - DVec3::new(0.0, 0.0, 1.8))
+        .collect();
+    let p = Params::gpp2();
+    let own = detect(&cloud(&pts), &p).unwrap();
+    assert_eq!(own.sensor, Some(DVec3::ZERO));
+    let shift = DVec3::new(500_000.0, 4_500_000.0, 100.0);
+    let flat: Vec<f64> = pts.iter().flat_map(|&q| (q + shift).to_array()).collect();
+    let moved = Cloud::from_flat_f64(&flat, 3).unwrap();
+    let map = detect(&moved, &p).unwrap();
+    assert_eq!(map.sensor, None);
+    let seen = Params {
+        viewpoint: Some(shift.to_array()),
+        ..Params::gpp2()
+    };
+    assert_eq!(detect(&moved, &seen).unwrap().sensor, Some(shift));
+    // Either way the ground is found.
+    assert_eq!(own.primitives.len(), 1);
+    assert_eq!(map.primitives.len(), 1);
+}
+
 /// A street location seen from its mean pose: horizontal planes at the
 /// heights where the laser rings cross the facades and car sides hold a
 /// band of each, as lines (a rejected candidate) or fragments (no patch

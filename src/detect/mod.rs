@@ -80,6 +80,11 @@ pub struct Detection {
     pub work: u64,
     /// Wall time (ms).
     pub time_ms: f64,
+    /// The sensor position [`detect`] went by (world, m): `viewpoint` when
+    /// given, the origin when it took the cloud for a scan in its own
+    /// frame, `None` when it saw the cloud from nowhere (a map). `None`
+    /// from [`Detector::run`], which is given its viewpoint.
+    pub sensor: Option<DVec3>,
 }
 
 /// Detect planar polygons in a world-frame cloud seen from
@@ -178,20 +183,29 @@ fn detect_all(
     progress: &mut dyn FnMut(&Progress) -> ControlFlow<()>,
 ) -> Option<Detection> {
     let policy = CascadePolicy::one_shot();
-    let (det, viewpoint) = if let Some(v) = params.viewpoint {
-        (Detector::new(params, policy), DVec3::from_array(v))
+    let (det, viewpoint, sensor) = if let Some(v) = params.viewpoint {
+        let v = DVec3::from_array(v);
+        (Detector::new(params, policy), v, Some(v))
     } else if sensor_could_stand_at(&cloud.points, -cloud.origin) {
-        (Detector::new(params, policy), DVec3::ZERO)
+        (
+            Detector::new(params, policy),
+            DVec3::ZERO,
+            Some(DVec3::ZERO),
+        )
     } else {
         // Seen from nowhere: normals face a point high above the centre.
         let n = cloud.points.len().max(1) as f64;
         let mean = cloud.points.iter().map(|p| p.as_dvec3()).sum::<DVec3>() / n;
         let viewpoint = cloud.origin + mean + DVec3::new(0.0, 0.0, 1e4);
-        (Detector::new(params, policy.without_viewpoint()), viewpoint)
+        (
+            Detector::new(params, policy.without_viewpoint()),
+            viewpoint,
+            None,
+        )
     };
     let rng = Rng::new(params.seed);
     let (found, stopped) = det.run_inner(&cloud.points, cloud.origin, viewpoint, rng, progress);
-    (!stopped).then_some(found)
+    (!stopped).then_some(Detection { sensor, ..found })
 }
 
 /// Where a detection is, after one of its rounds ([`detect_with_progress`]).
@@ -361,6 +375,7 @@ impl<'p> Detector<'p> {
             steps: Vec::new(),
             work: 0,
             time_ms: 0.0,
+            sensor: None,
         };
         let mut clusterer = cluster::Clusterer::default();
         let mut rejections = 0;

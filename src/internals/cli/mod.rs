@@ -425,11 +425,27 @@ fn detect_cmd(args: DetectArgs, mut params: Params) -> Result<String> {
     let file = read_cloud(&args.cloud, args.stride)?;
     let cloud = file.cloud().map_err(|e| in_file(&args.cloud, e))?;
     let found = crate::detect::detect(&cloud, &params)?;
+    if params.viewpoint.is_none() {
+        eprintln!("polyscene detect: {}", sensor_note(found.sensor));
+    }
     let doc = PolygonsJson {
         polygons: found.primitives.iter().map(PolygonJson::from).collect(),
         time_ms: found.time_ms,
     };
     write_or_return(&doc, args.out)
+}
+
+/// What `detect` took for the sensor when no `--viewpoint` or `--poses`
+/// said (on stderr: the two readings give different polygons).
+fn sensor_note(sensor: Option<glam::DVec3>) -> &'static str {
+    match sensor {
+        Some(_) => "no --viewpoint: the origin is taken for the sensor (a scan in its own frame)",
+        None => {
+            "no --viewpoint: no sensor could have stood at the origin, so the cloud is read as \
+             a map seen from nowhere (ground from its local floor, a coarse pass for sparse \
+             surfaces); for a scan in map coordinates give --viewpoint X,Y,Z or --poses FILE"
+        }
+    }
 }
 
 fn replay_cmd(args: ReplayArgs, params: Params) -> Result<String> {
