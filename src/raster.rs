@@ -183,10 +183,10 @@ fn keyholes(closed: &BitGrid, outside: &[bool], min_hole: usize) -> Vec<u32> {
             }
             continue;
         }
-        // The region cells a straight walk from (x, y) by (dx, dy) crosses
-        // before the exterior (the grid's border cells are all exterior).
+        // A straight walk from (x, y) by (dx, dy) up to what is open (the
+        // grid's border cells are all exterior): the region cells it
+        // crosses, and the cells of other holes it passes.
         let (x, y) = ((k0 % w) as isize, (k0 / w) as isize);
-        // Its cells and the holes' cells it passes, in order.
         let walk = |(dx, dy): (isize, isize)| {
             let (mut region, mut holes) = (Vec::new(), Vec::new());
             let (mut x, mut y) = (x + dx, y + dy);
@@ -811,7 +811,7 @@ mod tests {
 
     #[test]
     fn cuts_through_another_hole_cut_nothing_off() {
-        // A wide hole B near the region's bottom edge and a small hole A
+        // A wide hole B near the region's bottom edge and a smaller hole A
         // above it, whose shortest way out runs down through B. B's own
         // cut runs down from its first cell: two cuts from B to the edge
         // used to cut off the strip of region between them.
