@@ -165,18 +165,7 @@ fn keyholes(closed: &BitGrid, outside: &[bool], min_hole: usize) -> Vec<u32> {
         if state[k0] != HOLE {
             continue;
         }
-        state[k0] = FOUND;
-        let mut cells = vec![k0];
-        let mut i = 0;
-        while let Some(&k) = cells.get(i) {
-            i += 1;
-            for j in neighbours(k, w, h) {
-                if state[j] == HOLE {
-                    state[j] = FOUND;
-                    cells.push(j);
-                }
-            }
-        }
+        let cells = flood(&mut state, k0, w, h, |s| s == HOLE, FOUND);
         if cells.len() < min_hole {
             for &k in &cells {
                 state[k] = SMALL;
@@ -217,24 +206,39 @@ fn keyholes(closed: &BitGrid, outside: &[bool], min_hole: usize) -> Vec<u32> {
         for &k in &cut {
             state[k as usize] = OUT;
         }
-        for k0 in passed {
-            if state[k0] == OUT {
-                continue;
-            }
-            state[k0] = OUT;
-            let mut stack = vec![k0];
-            while let Some(k) = stack.pop() {
-                for j in neighbours(k, w, h) {
-                    if matches!(state[j], HOLE | SMALL) {
-                        state[j] = OUT;
-                        stack.push(j);
-                    }
-                }
+        for k in passed {
+            if state[k] != OUT {
+                flood(&mut state, k, w, h, |s| matches!(s, HOLE | SMALL), OUT);
             }
         }
         cuts.extend(cut);
     }
     cuts
+}
+
+/// Set `to` on cell `k0` and on every cell 4-connected to it through cells
+/// whose state is `from`; returns them.
+fn flood(
+    state: &mut [u8],
+    k0: usize,
+    w: usize,
+    h: usize,
+    from: impl Fn(u8) -> bool,
+    to: u8,
+) -> Vec<usize> {
+    state[k0] = to;
+    let mut cells = vec![k0];
+    let mut i = 0;
+    while let Some(&k) = cells.get(i) {
+        i += 1;
+        for j in neighbours(k, w, h) {
+            if from(state[j]) {
+                state[j] = to;
+                cells.push(j);
+            }
+        }
+    }
+    cells
 }
 
 /// The 4-neighbours of cell `k` of a `w` x `h` grid.

@@ -487,8 +487,10 @@ impl Footprint {
     /// nothing was seen, and the outline leaves it out: the region is cut
     /// along the shortest of four straight walks of cells (along the grid's
     /// axes) from the hole to its edge, and the ring runs in along one side
-    /// of the cut, around the hole and out along the other, a slit two
-    /// cells wide after the half-cell inset. A polygon is one simple ring, and stays so. Only
+    /// of the cut, around the hole and out along the other: a slit one cell
+    /// wide, or two where the traced ring is moved in by half a cell (not
+    /// where that would collapse a part one cell wide, as on most outlines
+    /// of real scans). A polygon is one simple ring, and stays so. Only
     /// an outline that fits `max_vertices` at `tolerance` with its holes
     /// left out gets them: a hole never costs the outer shape its
     /// resolution. The region's cells, for the point tests, hold the cuts'
@@ -563,37 +565,26 @@ impl Footprint {
                 Some(ring)
             };
             let tolerance = tolerance.max(0.0);
-            let mut fallback = None;
             // NaN and negative sizes cut no hole, nor does a hole of no cells.
             let min_hole = if min_hole >= 0.0 {
                 ((min_hole / (cs * cs)).ceil() as usize).max(1)
             } else {
                 usize::MAX
             };
-            // First without cuts; then, if that fits, with them.
-            let mut cuts: Option<Vec<u32>> = None;
-            let (mut out, inside) = loop {
-                let traced = closing
-                    .trace(cuts.as_deref().unwrap_or_default())
-                    .and_then(|(c, i)| Some((ring_of(c)?, i)));
-                let fits = traced
-                    .as_ref()
-                    .and_then(|(r, _)| simplify_within(r, tolerance, max_vertices));
-                match (traced, fits, cuts.is_some()) {
-                    (Some((_, i)), Some(o), false) => {
-                        let c = closing.cuts(min_hole);
-                        if c.is_empty() {
-                            break (o, i);
-                        }
-                        cuts = Some(c);
-                        fallback = Some((o, i));
-                    }
-                    (Some((_, i)), Some(o), true) => break (o, i),
-                    (Some((r, i)), None, false) => {
-                        break (simplify_raised(&r, tolerance, max_vertices), i)
-                    }
-                    (None, _, false) => return None,
-                    _ => break fallback?,
+            let trace = |cuts: &[u32]| {
+                closing
+                    .trace(cuts)
+                    .and_then(|(c, inside)| Some((ring_of(c)?, inside)))
+            };
+            // First with every hole filled; the cuts only if that fits.
+            let (ring, inside) = trace(&[])?;
+            let (mut out, inside) = match simplify_within(&ring, tolerance, max_vertices) {
+                None => (simplify_raised(&ring, tolerance, max_vertices), inside),
+                Some(filled) => {
+                    let cuts = closing.cuts(min_hole);
+                    let cut = if cuts.is_empty() { None } else { trace(&cuts) };
+                    cut.and_then(|(r, i)| Some((simplify_within(&r, tolerance, max_vertices)?, i)))
+                        .unwrap_or((filled, inside))
                 }
             };
             make_ccw(&mut out);
