@@ -182,27 +182,22 @@ fn detect_all(
     params: &Params,
     progress: &mut dyn FnMut(&Progress) -> ControlFlow<()>,
 ) -> Option<Detection> {
-    let policy = CascadePolicy::one_shot();
-    let (det, viewpoint, sensor) = if let Some(v) = params.viewpoint {
-        let v = DVec3::from_array(v);
-        (Detector::new(params, policy), v, Some(v))
-    } else if sensor_could_stand_at(&cloud.points, -cloud.origin) {
-        (
-            Detector::new(params, policy),
-            DVec3::ZERO,
-            Some(DVec3::ZERO),
-        )
-    } else {
-        // Seen from nowhere: normals face a point high above the centre.
-        let n = cloud.points.len().max(1) as f64;
-        let mean = cloud.points.iter().map(|p| p.as_dvec3()).sum::<DVec3>() / n;
-        let viewpoint = cloud.origin + mean + DVec3::new(0.0, 0.0, 1e4);
-        (
-            Detector::new(params, policy.without_viewpoint()),
-            viewpoint,
-            None,
-        )
+    // The given viewpoint, or the origin for a scan in its own frame.
+    let sensor = match params.viewpoint {
+        Some(v) => Some(DVec3::from_array(v)),
+        None => sensor_could_stand_at(&cloud.points, -cloud.origin).then_some(DVec3::ZERO),
     };
+    let (policy, viewpoint) = match sensor {
+        Some(v) => (CascadePolicy::one_shot(), v),
+        None => {
+            // Seen from nowhere: normals face a point high above the centre.
+            let n = cloud.points.len().max(1) as f64;
+            let mean = cloud.points.iter().map(|p| p.as_dvec3()).sum::<DVec3>() / n;
+            let above = cloud.origin + mean + DVec3::new(0.0, 0.0, 1e4);
+            (CascadePolicy::one_shot().without_viewpoint(), above)
+        }
+    };
+    let det = Detector::new(params, policy);
     let rng = Rng::new(params.seed);
     let (found, stopped) = det.run_inner(&cloud.points, cloud.origin, viewpoint, rng, progress);
     (!stopped).then_some(Detection { sensor, ..found })
