@@ -254,6 +254,12 @@ pub(crate) struct Shaped {
     /// the inlier slab (a plane cutting through objects), far less for a
     /// surface.
     pub roughness: f64,
+    /// Share of the kept support points within half the inlier distance of
+    /// the plane: near 1 for a surface with noise, about a half for points
+    /// spread evenly through the slab, in between for a plane that holds
+    /// two surfaces, one at either side of it (a road and the sidewalk a
+    /// curb above it, under a plane tilted to hold both).
+    pub tight_share: f64,
     /// Frame coordinates of every support point (for
     /// [`Shaped::consistency`]).
     q: Vec<DVec2>,
@@ -269,6 +275,18 @@ impl Shaped {
     /// demand: it is the costliest acceptance test (a plane fit per patch),
     /// so the cascade asks for it only when every other test passed.
     pub fn consistency(&self, origin: DVec3, pts: &[Vec3], params: &Params) -> f64 {
+        self.patches(origin, pts, params).0
+    }
+
+    /// The noise of the support's surfaces: the median, over the patches
+    /// [`Shaped::consistency`] judges (those with a well-defined normal),
+    /// of their points' RMS distance from their own PCA plane. `None` when
+    /// no patch has a normal.
+    pub fn patch_noise(&self, origin: DVec3, pts: &[Vec3], params: &Params) -> Option<f64> {
+        self.patches(origin, pts, params).1
+    }
+
+    fn patches(&self, origin: DVec3, pts: &[Vec3], params: &Params) -> (f64, Option<f64>) {
         normal_consistency(
             origin,
             pts,
@@ -380,7 +398,7 @@ impl Shaped {
     }
 }
 
-/// See [`Shaped::consistency`].
+/// See [`Shaped::consistency`] and [`Shaped::patch_noise`].
 fn normal_consistency(
     origin: DVec3,
     pts: &[Vec3],
@@ -388,7 +406,7 @@ fn normal_consistency(
     kept: &[bool],
     frame: &Frame,
     cell: f64,
-) -> f64 {
+) -> (f64, Option<f64>) {
     // Large supports are judged on an even-strided subsample of 100k points.
     let step = pts.len().div_ceil(100_000).max(1);
     let chosen: Vec<usize> = (0..pts.len()).step_by(step).filter(|&i| kept[i]).collect();
@@ -413,6 +431,7 @@ fn normal_consistency(
         cells[c as usize].push(w);
     }
     let (mut good, mut total) = (0usize, 0usize);
+    let mut noise: Vec<f64> = Vec::new();
     let cos_max = libm::cos(15f64.to_radians());
     for m in &cells {
         if m.count < 6.0 {
@@ -429,11 +448,14 @@ fn normal_consistency(
         }
         total += 1;
         good += (normal.dot(frame.normal).abs() >= cos_max) as usize;
+        noise.push(vals[0].max(0.0).sqrt());
     }
+    let mid = noise.len() / 2;
+    let median = (!noise.is_empty()).then(|| *noise.select_nth_unstable_by(mid, f64::total_cmp).1);
     if total == 0 {
-        1.0
+        (1.0, None)
     } else {
-        good as f64 / total as f64
+        (good as f64 / total as f64, median)
     }
 }
 
@@ -551,13 +573,15 @@ pub(crate) fn shape(
     if area.is_nan() || area <= 0.0 {
         return None;
     }
-    let (mut sq, mut nk) = (0.0, 0usize);
+    let (mut sq, mut nk, mut tight) = (0.0, 0usize, 0usize);
     for (&p, _) in world.iter().zip(&kept).filter(|(_, &k)| k) {
         let d = plane.signed_distance(p);
         sq += d * d;
         nk += 1;
+        tight += usize::from(d.abs() <= 0.5 * threshold);
     }
     let roughness = (sq / nk.max(1) as f64).sqrt() / threshold;
+    let tight_share = tight as f64 / nk.max(1) as f64;
     Some(Shaped {
         primitive: Primitive {
             id: 0,
@@ -574,6 +598,7 @@ pub(crate) fn shape(
         },
         kept,
         roughness,
+        tight_share,
         q,
     })
 }

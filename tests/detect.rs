@@ -215,6 +215,136 @@ fn coplanar_walls_with_a_gap_stay_two_polygons() {
     }
 }
 
+/// A facade bent by 6 degrees (two faces of 4 m x 3 m meeting at a vertical
+/// edge): a plane between the two faces holds both within the inlier
+/// distance, more points than either face's own plane, and fails the
+/// roughness test. Judged as its dominant layer, the candidate gives the
+/// face whose plane holds the most of it within its noise, and the other
+/// face stays in play for a later round; when the candidate left play
+/// with its points, both faces were lost at one of these eight RANSAC
+/// seeds.
+#[test]
+fn a_facade_bent_by_a_few_degrees_gives_both_faces() {
+    let mut rng = Rng::new(6);
+    let mut pts = Vec::new();
+    let half = 3f64.to_radians();
+    let faces = [
+        DVec3::new(half.cos(), half.sin(), 0.0),
+        DVec3::new(-half.cos(), half.sin(), 0.0),
+    ];
+    let edge = DVec3::new(0.0, 8.0, -1.8);
+    for &u in &faces {
+        rect(&mut pts, edge, u, DVec3::Z, 4.0, 3.0, 0.05, 0.01, &mut rng);
+    }
+    let ground = DVec3::new(-10.0, -10.0, -1.8);
+    rect(
+        &mut pts,
+        ground,
+        DVec3::X,
+        DVec3::Y,
+        20.0,
+        17.9,
+        0.1,
+        0.01,
+        &mut rng,
+    );
+    let cloud = cloud(&pts);
+    for seed in 1..=8 {
+        let p = Params {
+            seed,
+            ..Params::gpp2()
+        };
+        let det = detect(&cloud, &p).unwrap();
+        check_invariants(&cloud, &det, &p);
+        for &u in &faces {
+            let normal = u.cross(DVec3::Z).normalize();
+            let middle = edge + u * 2.0 + DVec3::Z * 1.5;
+            let face = det.primitives.iter().find(|q| {
+                q.plane.normal.dot(normal).abs() > 2f64.to_radians().cos()
+                    && contains(&q.outline, q.frame.to_local(middle))
+            });
+            let area = face.map_or(0.0, |q| q.area);
+            // (The face found first takes the band of the other that its
+            // plane's slab holds along the edge: 6-9 m^2 of 12 are left.)
+            assert!(area > 5.0, "seed {seed}: the face along {u} has {area} m^2");
+        }
+    }
+}
+
+/// A road 10 m wide between two sidewalks a curb (0.15 m) above it, with no
+/// curb faces and no viewpoint (a map tile): a plane tilted 0.7 degrees
+/// holds the road at one side and a sidewalk at the other within the
+/// ground's inlier distance, and more of their points than either surface's
+/// own plane. Such a compromise either failed roughness and left play with
+/// both surfaces, or passed it (a tilted slab over the road and a sidewalk).
+/// When the cascade judged a candidate by roughness alone, a sidewalk was
+/// lost at the first of these eight RANSAC seeds.
+#[test]
+fn a_road_between_two_sidewalks_a_curb_up_gives_three_level_surfaces() {
+    let mut rng = Rng::new(8);
+    let mut pts = Vec::new();
+    // (y from, width, height)
+    let surfaces = [(-13.0, 8.0, 0.15), (-5.0, 10.0, 0.0), (5.0, 8.0, 0.15)];
+    for &(y, w, z) in &surfaces {
+        let at = DVec3::new(0.0, y, z);
+        rect(
+            &mut pts,
+            at,
+            DVec3::X,
+            DVec3::Y,
+            40.0,
+            w - 0.1,
+            0.1,
+            0.01,
+            &mut rng,
+        );
+    }
+    let cloud = cloud(&pts);
+    let level = 1f64.to_radians().cos();
+    for seed in 1..=8 {
+        let p = Params {
+            seed,
+            ..Params::gpp2()
+        };
+        let det = detect(&cloud, &p).unwrap();
+        check_invariants(&cloud, &det, &p);
+        // No polygon spans two heights or leans.
+        for q in det.primitives.iter().filter(|q| q.area > 5.0) {
+            let z: Vec<f64> = q.outline.iter().map(|&v| q.frame.to_world(v).z).collect();
+            let on = |h: f64| z.iter().all(|&z| (z - h).abs() < 0.05);
+            let (lo, hi) = z
+                .iter()
+                .fold((f64::MAX, f64::MIN), |(l, h), &z| (l.min(z), h.max(z)));
+            assert!(
+                q.plane.normal.z.abs() > level && (on(0.0) || on(0.15)),
+                "seed {seed}: a {} m^2 polygon with normal {} spans heights {lo} to {hi}",
+                q.area,
+                q.plane.normal
+            );
+        }
+        // Each surface is covered: nine tenths of a grid over it lie in a
+        // level polygon at its height.
+        for &(y, w, z) in &surfaces {
+            let (mut inside, mut all) = (0, 0);
+            for i in 0..20 {
+                for j in 0..(w as usize) {
+                    let at = DVec3::new(1.0 + 2.0 * i as f64, y + 0.5 + j as f64, z);
+                    all += 1;
+                    inside += usize::from(det.primitives.iter().any(|q| {
+                        q.plane.normal.z.abs() > level
+                            && q.plane.signed_distance(at).abs() < 0.05
+                            && contains(&q.outline, q.frame.to_local(at))
+                    }));
+                }
+            }
+            assert!(
+                10 * inside >= 9 * all,
+                "seed {seed}: the surface at y {y}, z {z} has {inside} of {all} in a polygon"
+            );
+        }
+    }
+}
+
 /// One plane often holds several surfaces: the sides of cars parked in a
 /// row. Every cluster of the round's plane is judged, so all five are found
 /// in the round that found the first; the paper's cascade (the largest
@@ -1198,9 +1328,13 @@ fn detection_reports_the_sensor_it_went_by() {
 /// that, sparse facades and car sides lose a band with every such round.
 /// Local triples (`CascadePolicy::local_triples`) make such planes rarer,
 /// so sparing gains less than it did with triples across the cloud
-/// (recall 0.580 against 0.527 at scan 60 then). Four locations along the
-/// street (scans 20-80), on average: measured recall 0.532 against 0.514,
-/// completeness 0.901 against 0.889, precision 0.994.
+/// (recall 0.580 against 0.527 at scan 60 then). Judging a candidate's
+/// dominant layer (`CascadePolicy::split_rough_layers`) keeps some of the
+/// same bands in play, so sparing's own gain is measured with that off in
+/// both arms; the cascade as it runs is judged on its own. Four locations
+/// along the street (scans 20-80), on average: measured recall 0.532
+/// against 0.514, completeness 0.901 against 0.889; as it runs, recall
+/// 0.530, precision 0.994.
 #[test]
 fn a_plane_through_clutter_spares_the_surfaces_it_crosses() {
     use polyscene::detect::CascadePolicy;
@@ -1209,26 +1343,32 @@ fn a_plane_through_clutter_spares_the_surfaces_it_crosses() {
     let n = starts.len() as f64;
     let (mut with_recall, mut without_recall) = (0.0, 0.0);
     let (mut with_complete, mut without_complete) = (0.0, 0.0);
-    let mut precision = 0.0;
+    let (mut recall, mut precision) = (0.0, 0.0);
     for start in starts {
         let loc = drive.location(start, 10).unwrap();
-        let (with, without) = with_and_without(
+        let unsplit = CascadePolicy {
+            split_rough_layers: false,
+            ..CascadePolicy::one_shot()
+        };
+        let (runs, with) = with_and_without(&loc, unsplit);
+        let without = run_with(
             &loc,
             CascadePolicy {
                 spare_crossing_surfaces: false,
-                ..CascadePolicy::one_shot()
+                ..unsplit
             },
         );
         let score = |det| score_location(det, &gt, &loc);
-        let (a, b) = (score(&with), score(&without));
-        assert_eq!(a.duplicates.count, 0, "scan {start}");
+        let (r, a, b) = (score(&runs), score(&with), score(&without));
+        assert_eq!(r.duplicates.count, 0, "scan {start}");
+        recall += r.detection.recall / n;
+        precision += r.detection.precision / n;
         with_recall += a.detection.recall / n;
         without_recall += b.detection.recall / n;
         with_complete += a.completeness.completeness / n;
         without_complete += b.completeness.completeness / n;
-        precision += a.detection.precision / n;
     }
-    assert!(with_recall > 0.52, "recall {with_recall}");
+    assert!(recall > 0.52, "recall {recall}");
     assert!(
         with_recall > without_recall + 0.015,
         "recall {with_recall} against {without_recall}"
@@ -1309,6 +1449,20 @@ fn with_and_without(
     check_invariants(&cloud, &with, &p);
     let without = Detector::new(&p, policy).run(&cloud.points, cloud.origin, loc.viewpoint());
     (with, without)
+}
+
+/// One-shot detection of a location from its mean pose under `policy`.
+fn run_with(
+    loc: &polyscene::sim::Location,
+    policy: polyscene::detect::CascadePolicy,
+) -> polyscene::detect::Detection {
+    use polyscene::detect::Detector;
+    let cloud = Cloud::from_world_f64(&loc.points).unwrap();
+    let p = Params {
+        viewpoint: Some(loc.viewpoint().to_array()),
+        ..Params::gpp2()
+    };
+    Detector::new(&p, policy).run(&cloud.points, cloud.origin, loc.viewpoint())
 }
 
 /// The simulated drive of a layout (seed 1) and its ground-truth surfaces.

@@ -447,11 +447,14 @@ impl<'p> Detector<'p> {
                     if k == 0 {
                         step.area = judged.shaped.as_ref().map_or(0.0, |s| s.primitive.area);
                     }
-                    // Too rough, nothing else wrong, and in two layers: two
-                    // surfaces a step apart. Judge the larger one alone; the
-                    // rest of the cluster stays in play.
+                    // Too rough, nothing else wrong, or smooth enough but
+                    // not tight: perhaps two surfaces that one plane holds
+                    // (a step, a bend, a road and a sidewalk under a tilted
+                    // plane). Judge the dominant one alone; the rest of the
+                    // cluster stays in play. (When it fails, a rough
+                    // candidate leaves play, and a smooth one is kept.)
                     let mut layer: Option<round::Candidate> = None;
-                    if policy.split_rough_layers && judged.only_too_rough {
+                    if policy.split_rough_layers && (judged.only_too_rough || judged.maybe_two) {
                         if let Some((near, again)) =
                             judge.dominant_layer(&judged, cluster, support_pts)
                         {

@@ -63,12 +63,15 @@ pub struct CascadePolicy {
     /// or clusters found (with outlines that can merge, see
     /// [`HullKind`](crate::params::HullKind)).
     pub merge_pieces: bool,
-    /// A candidate that fails only the roughness test, and whose points lie
-    /// in two parallel layers with a gap between them, is two surfaces a
-    /// step apart that one plane holds within the inlier distance (a road
-    /// and a plaza 10 cm higher): the layer holding more points is judged
-    /// on its own and the rest stays in play, instead of the whole
-    /// candidate leaving play.
+    /// A candidate that fails only the roughness test, or passes it with
+    /// fewer of its points near its plane than a surface has, is often two
+    /// surfaces that one plane holds within the inlier distance: a road and
+    /// a plaza 10 cm higher (two parallel layers with a gap between them), a
+    /// road and the sidewalk a curb above it under a plane tilted to hold
+    /// one at each side, the two faces of a facade bent by a few degrees.
+    /// Its dominant layer is judged on its own and the rest stays in play,
+    /// instead of the whole candidate leaving play (or a tilted plane over
+    /// both being accepted). See `Judge::dominant_layer`.
     pub split_rough_layers: bool,
     /// When `maxRejections` rounds in a row accepted nothing, the points of
     /// every sampling voxel that holds no plane (their spread across the

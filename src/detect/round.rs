@@ -132,6 +132,32 @@ pub(crate) struct Judged {
     pub(crate) accepted: bool,
     /// Passed every test but roughness.
     pub(crate) only_too_rough: bool,
+    /// Accepted, but with fewer of its points within half the inlier
+    /// distance than a surface as rough as `maxRoughness` allows would
+    /// have ([`least_tight_share`]): perhaps two surfaces that one plane
+    /// between them holds, smoothly enough to pass.
+    pub(crate) maybe_two: bool,
+}
+
+/// The share of a surface's points within half the inlier distance of its
+/// plane when their distances are normal with an RMS of `maxRoughness`
+/// times the inlier distance: the share of the roughest surface the
+/// roughness test accepts (0.73 at the default 0.45). Points spread evenly
+/// through the slab put a half there.
+#[inline(never)]
+pub(crate) fn least_tight_share(p: &Params) -> f64 {
+    // erf(x) by its Taylor series (libm's erf would add 2 kB to the wasm);
+    // beyond x = 3 it is 1 to within 3e-5.
+    let x = 0.5 / (p.max_roughness * core::f64::consts::SQRT_2);
+    if x.is_nan() || x >= 3.0 {
+        return 1.0;
+    }
+    let (mut term, mut sum) = (x, x);
+    for n in 1..60 {
+        term *= -x * x / n as f64;
+        sum += term / (2 * n + 1) as f64;
+    }
+    sum * core::f64::consts::FRAC_2_SQRT_PI
 }
 
 /// What judging a candidate needs besides its points: where the cloud and
@@ -185,10 +211,14 @@ impl Judge<'_> {
             .as_ref()
             .is_some_and(|s| s.roughness <= p.max_roughness);
         let rest = shaped.as_ref().is_some_and(rest_ok);
+        let tight = shaped
+            .as_ref()
+            .is_some_and(|s| s.tight_share >= least_tight_share(p));
         Judged {
             shaped,
             accepted: smooth && rest,
             only_too_rough: !smooth && rest,
+            maybe_two: smooth && rest && !tight,
         }
     }
 
@@ -223,18 +253,28 @@ impl Judge<'_> {
     }
 
     /// A candidate (`cluster`, `support_pts`) that failed only roughness
-    /// ([`Judged::only_too_rough`]), judged again as the layer that holds
-    /// more of its points, when its points lie in two layers
-    /// ([`two_layers`]): the points within the inlier distance of that
-    /// layer's plane. `Some((layer, judged))` when the layer is accepted;
-    /// the rest of the candidate stays in play.
+    /// ([`Judged::only_too_rough`]) or may hold two surfaces
+    /// ([`Judged::maybe_two`]), judged again as its dominant layer:
+    /// - when its points lie in two parallel layers with a gap between them
+    ///   ([`two_layers`], a road and a plaza a step up), the points within
+    ///   the inlier distance of the plane of the layer that holds more;
+    /// - else the points within twice the noise band of the plane that
+    ///   holds the most of the candidate's points within that band
+    ///   ([`tightest_plane`]; the band is three times the candidate's local
+    ///   noise, `Shaped::patch_noise`, at most half the inlier distance), when
+    ///   most of them lie within the band itself, as a surface's do (at
+    ///   least [`least_tight_share`]; a slab cut from uniform clutter puts
+    ///   half of its points there).
+    ///
+    /// `Some((layer, judged))` when the layer is accepted; the rest of the
+    /// candidate stays in play.
     pub(crate) fn dominant_layer(
         &self,
-        rough: &Judged,
+        judged: &Judged,
         cluster: &[u32],
         support_pts: &[Vec3],
     ) -> Option<(Candidate, Judged)> {
-        let s = rough.shaped.as_ref()?;
+        let s = judged.shaped.as_ref()?;
         let world: Vec<DVec3> = support_pts
             .iter()
             .map(|q| self.origin + q.as_dvec3())
@@ -244,11 +284,31 @@ impl Judge<'_> {
         // a plane needs no more, and a road's candidate can hold a million.
         let every = world.len().div_ceil(50_000).max(1);
         let sample: Vec<DVec3> = world.iter().copied().step_by(every).collect();
-        let layer = two_layers(&s.primitive.plane, &sample, distance)?;
-        let near: Vec<usize> = (0..world.len())
-            .filter(|&i| layer.signed_distance(world[i]).abs() <= distance)
+        let plane = &s.primitive.plane;
+        let (layer, band, tight) = match two_layers(plane, &sample, distance) {
+            Some(layer) => (layer, distance, false),
+            None => {
+                let noise = s.patch_noise(self.origin, support_pts, self.p);
+                let band = noise.map_or(0.5 * distance, |sigma| {
+                    (NOISE_BAND * sigma).min(0.5 * distance)
+                });
+                // A stream of its own, fixed by the seed and the
+                // candidate's size: the same input gives the same planes.
+                let mut rng = crate::rng::Rng::derive(self.p.seed, world.len() as u64);
+                let layer = tightest_plane(&sample, band, &mut rng)?;
+                (layer, 2.0 * band, true)
+            }
+        };
+        let off: Vec<f64> = world
+            .iter()
+            .map(|&w| layer.signed_distance(w).abs())
             .collect();
+        let near: Vec<usize> = (0..world.len()).filter(|&i| off[i] <= band).collect();
         if near.len() < self.p.min_inliers || near.len() == world.len() {
+            return None;
+        }
+        let within = off.iter().filter(|&&d| d <= 0.5 * band).count();
+        if tight && (within as f64) < least_tight_share(self.p) * near.len() as f64 {
             return None;
         }
         let (layer, again) = self.judge_part(cluster, support_pts, &near);
@@ -306,4 +366,97 @@ fn two_layers(plane: &Plane, world: &[DVec3], distance: f64) -> Option<Plane> {
         .filter(|&d| d > step / 3.0 && d < 2.0 * step / 3.0)
         .count();
     (10 * middle < h.len()).then_some(layer)
+}
+
+/// The noise band of [`Judge::dominant_layer`], in multiples of the local
+/// noise: a surface with normal noise keeps 99.7 % of its points within it.
+const NOISE_BAND: f64 = 3.0;
+
+/// Hypotheses [`tightest_plane`] tries.
+const TIGHT_HYPOTHESES: usize = 200;
+
+/// The plane that holds the most of `world` (a candidate's points; at most
+/// 5,000 of them) within `band`: the best of [`TIGHT_HYPOTHESES`] planes
+/// through three of the points, refit twice on the points within `band`.
+/// Where one plane between two surfaces holds both within the inlier
+/// distance (a road and the sidewalk a curb above it, the plane tilted to
+/// hold one at each side; the two faces of a bent facade), it holds each
+/// only in a strip as wide as the band allows, while each surface's own
+/// plane holds all of it: with a band near the surfaces' noise, the larger
+/// surface's plane wins.
+fn tightest_plane(world: &[DVec3], band: f64, rng: &mut crate::rng::Rng) -> Option<Plane> {
+    use crate::geometry::plane::robust_fit;
+    let every = world.len().div_ceil(5_000).max(1);
+    let pts: Vec<DVec3> = world.iter().copied().step_by(every).collect();
+    let n = pts.len();
+    if n < 3 {
+        return None;
+    }
+    let held = |plane: &Plane| {
+        pts.iter()
+            .filter(|&&w| plane.signed_distance(w).abs() <= band)
+            .count()
+    };
+    let mut best: Option<(usize, Plane)> = None;
+    for _ in 0..TIGHT_HYPOTHESES {
+        let (a, b, c) = (pts[rng.below(n)], pts[rng.below(n)], pts[rng.below(n)]);
+        let (u, v) = (b - a, c - a);
+        let cross = u.cross(v);
+        // Not a sliver: the triangle's height at least a tenth of its
+        // longest side.
+        let side = u
+            .length_squared()
+            .max(v.length_squared())
+            .max((c - b).length_squared());
+        let fat = cross.length_squared() > 0.01 * side * side;
+        if !fat {
+            continue;
+        }
+        let normal = cross.normalize();
+        let plane = Plane {
+            normal,
+            offset: -normal.dot(a),
+        };
+        let k = held(&plane);
+        if best.is_none_or(|(most, _)| k > most) {
+            best = Some((k, plane));
+        }
+    }
+    let mut plane = best?.1;
+    for _ in 0..2 {
+        let near: Vec<DVec3> = pts
+            .iter()
+            .copied()
+            .filter(|&w| plane.signed_distance(w).abs() <= band)
+            .collect();
+        plane = robust_fit(&near, near.first()?.round())?.plane;
+    }
+    Some(plane)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_least_tight_share_is_that_of_normal_noise_at_the_roughness_allowed() {
+        // erf(0.5 / (r * sqrt 2)) for r = maxRoughness.
+        for (r, share) in [
+            (0.45, 0.733_479_474),
+            (1.0, 0.382_924_923),
+            (0.2, 0.987_580_669),
+        ] {
+            let p = Params {
+                max_roughness: r,
+                ..Params::gpp2()
+            };
+            assert!((least_tight_share(&p) - share).abs() < 1e-8, "{r}");
+        }
+        // Beyond the series' range: all of a surface's points.
+        let p = Params {
+            max_roughness: 0.1,
+            ..Params::gpp2()
+        };
+        assert_eq!(least_tight_share(&p), 1.0);
+    }
 }
