@@ -250,12 +250,7 @@ fn a_facade_bent_by_a_few_degrees_gives_both_faces() {
     );
     let cloud = cloud(&pts);
     for seed in 1..=8 {
-        let p = Params {
-            seed,
-            ..Params::gpp2()
-        };
-        let det = detect(&cloud, &p).unwrap();
-        check_invariants(&cloud, &det, &p);
+        let det = detect_at_seed(&cloud, seed);
         for &u in &faces {
             let normal = u.cross(DVec3::Z).normalize();
             let middle = edge + u * 2.0 + DVec3::Z * 1.5;
@@ -302,12 +297,7 @@ fn a_road_between_two_sidewalks_a_curb_up_gives_three_level_surfaces() {
     let cloud = cloud(&pts);
     let level = 1f64.to_radians().cos();
     for seed in 1..=8 {
-        let p = Params {
-            seed,
-            ..Params::gpp2()
-        };
-        let det = detect(&cloud, &p).unwrap();
-        check_invariants(&cloud, &det, &p);
+        let det = detect_at_seed(&cloud, seed);
         // No polygon spans two heights or leans.
         for q in det.primitives.iter().filter(|q| q.area > 5.0) {
             let z: Vec<f64> = q.outline.iter().map(|&v| q.frame.to_world(v).z).collect();
@@ -343,6 +333,17 @@ fn a_road_between_two_sidewalks_a_curb_up_gives_three_level_surfaces() {
             );
         }
     }
+}
+
+/// Default detection of `cloud` at RANSAC `seed`, its invariants checked.
+fn detect_at_seed(cloud: &Cloud, seed: u64) -> polyscene::detect::Detection {
+    let p = Params {
+        seed,
+        ..Params::gpp2()
+    };
+    let det = detect(cloud, &p).unwrap();
+    check_invariants(cloud, &det, &p);
+    det
 }
 
 /// One plane often holds several surfaces: the sides of cars parked in a
