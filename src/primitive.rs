@@ -274,19 +274,11 @@ impl Shaped {
     /// normal. `origin` and `pts` are what [`shape`] was given. Computed on
     /// demand: it is the costliest acceptance test (a plane fit per patch),
     /// so the cascade asks for it only when every other test passed.
-    pub fn consistency(&self, origin: DVec3, pts: &[Vec3], params: &Params) -> f64 {
-        self.patches(origin, pts, params).0
-    }
-
-    /// The noise of the support's surfaces: the median, over the patches
-    /// [`Shaped::consistency`] judges (those with a well-defined normal),
-    /// of their points' RMS distance from their own PCA plane. `None` when
-    /// no patch has a normal.
-    pub fn patch_noise(&self, origin: DVec3, pts: &[Vec3], params: &Params) -> Option<f64> {
-        self.patches(origin, pts, params).1
-    }
-
-    fn patches(&self, origin: DVec3, pts: &[Vec3], params: &Params) -> (f64, Option<f64>) {
+    /// With it, from the same patch fits, the noise of the support's
+    /// surfaces: the median over those patches of their points' RMS
+    /// distance from their own PCA plane (`None` when no patch has a
+    /// normal).
+    pub fn consistency(&self, origin: DVec3, pts: &[Vec3], params: &Params) -> (f64, Option<f64>) {
         normal_consistency(
             origin,
             pts,
@@ -398,7 +390,7 @@ impl Shaped {
     }
 }
 
-/// See [`Shaped::consistency`] and [`Shaped::patch_noise`].
+/// See [`Shaped::consistency`].
 fn normal_consistency(
     origin: DVec3,
     pts: &[Vec3],

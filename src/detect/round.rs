@@ -132,6 +132,9 @@ pub(crate) struct Judged {
     pub(crate) accepted: bool,
     /// Passed every test but roughness.
     pub(crate) only_too_rough: bool,
+    /// The noise of its surfaces, from the consistency test's patch fits
+    /// ([`Shaped::consistency`]), when it got that far.
+    pub(crate) noise: Option<f64>,
     /// Accepted, but with fewer of its points within half the inlier
     /// distance than a surface as rough as `maxRoughness` allows would
     /// have ([`least_tight_share`]): perhaps two surfaces that one plane
@@ -146,7 +149,7 @@ pub(crate) struct Judged {
 /// through the slab put a half there.
 #[inline(never)]
 pub(crate) fn least_tight_share(p: &Params) -> f64 {
-    // erf(x) by its Taylor series (libm's erf would add 2 kB to the wasm);
+    // erf(x) by its Taylor series (libm's erf added 2.6 kB to the wasm);
     // beyond x = 3 it is 1 to within 3e-5.
     let x = 0.5 / (p.max_roughness * core::f64::consts::SQRT_2);
     if x.is_nan() || x >= 3.0 {
@@ -198,19 +201,23 @@ impl Judge<'_> {
                 cut_holes: self.policy.cut_holes,
             },
         );
-        let rest_ok = |s: &Shaped| {
+        let cheap_ok = |s: &&Shaped| {
             s.primitive.acceptable_with(p, self.min_support)
                 // (Only the pool's smaller least support lets such a
                 // candidate through to here.)
                 && !(s.primitive.support < p.min_inliers as u64 && self.at_ground_depth(s))
                 && !(self.policy.reject_edge_on_candidates && seen_edge_on(s, viewpoint, p))
                 && !(self.policy.reject_domes && s.domed(self.origin, support_pts, viewpoint))
-                && s.consistency(self.origin, support_pts, p) >= p.min_normal_consistency
         };
+        // The costliest test last, and only when the others passed.
+        let patches = shaped
+            .as_ref()
+            .filter(cheap_ok)
+            .map(|s| s.consistency(self.origin, support_pts, p));
         let smooth = shaped
             .as_ref()
             .is_some_and(|s| s.roughness <= p.max_roughness);
-        let rest = shaped.as_ref().is_some_and(rest_ok);
+        let rest = patches.is_some_and(|(c, _)| c >= p.min_normal_consistency);
         let tight = shaped
             .as_ref()
             .is_some_and(|s| s.tight_share >= least_tight_share(p));
@@ -218,6 +225,7 @@ impl Judge<'_> {
             shaped,
             accepted: smooth && rest,
             only_too_rough: !smooth && rest,
+            noise: patches.and_then(|(_, noise)| noise),
             maybe_two: smooth && rest && !tight,
         }
     }
@@ -261,7 +269,7 @@ impl Judge<'_> {
     /// - else the points within twice the noise band of the plane that
     ///   holds the most of the candidate's points within that band
     ///   ([`tightest_plane`]; the band is three times the candidate's local
-    ///   noise, `Shaped::patch_noise`, at most half the inlier distance), when
+    ///   noise, [`Judged::noise`], at most half the inlier distance), when
     ///   most of them lie within the band itself, as a surface's do (at
     ///   least [`least_tight_share`]; a slab cut from uniform clutter puts
     ///   half of its points there).
@@ -288,8 +296,7 @@ impl Judge<'_> {
         let (layer, band, tight) = match two_layers(plane, &sample, distance) {
             Some(layer) => (layer, distance, false),
             None => {
-                let noise = s.patch_noise(self.origin, support_pts, self.p);
-                let band = noise.map_or(0.5 * distance, |sigma| {
+                let band = judged.noise.map_or(0.5 * distance, |sigma| {
                     (NOISE_BAND * sigma).min(0.5 * distance)
                 });
                 // A stream of its own, fixed by the seed and the
