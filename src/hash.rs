@@ -495,6 +495,79 @@ pub fn voxelise(pts: &[glam::Vec3], voxel: f64) -> Voxels {
     out
 }
 
+/// Points grouped by cubic voxel: the voxels ([`voxelise`]), their side
+/// and each one's members. One-shot detection builds it once for its
+/// sampling voxels and counts neighbours in it too.
+pub struct VoxelGrid {
+    /// Side of a voxel (m).
+    pub side: f64,
+    /// Each point's voxel, voxel coordinates and ids.
+    pub voxels: Voxels,
+    /// The points (indices) of each voxel id, in increasing order.
+    pub members: Buckets,
+}
+
+impl VoxelGrid {
+    /// `pts` in voxels of side `side`.
+    pub fn new(pts: &[glam::Vec3], side: f64) -> Self {
+        let voxels = voxelise(pts, side);
+        let members = Buckets::new(&voxels.cell_of, voxels.coords.len());
+        VoxelGrid {
+            side,
+            voxels,
+            members,
+        }
+    }
+
+    /// Points of `pts` (the cloud the grid was built on) within `r` of
+    /// point `i` (Euclidean, in `f32` as the points are), `i` itself not
+    /// counted, up to `most + 1`: the count stops there. The voxels that a
+    /// ball of radius `r` can reach are read, `i`'s own first, where most
+    /// neighbours are.
+    pub fn neighbours_up_to(&self, pts: &[glam::Vec3], i: usize, r: f64, most: usize) -> usize {
+        let q = pts[i];
+        let r2 = (r * r) as f32;
+        let own = self.voxels.cell_of[i];
+        let mut n = 0usize;
+        // Within the voxel `id`: false once past `most`.
+        let mut count = |id: u32| -> bool {
+            for &j in self.members.of(id as usize) {
+                if j as usize != i && (pts[j as usize] - q).length_squared() <= r2 {
+                    n += 1;
+                    if n > most {
+                        return false;
+                    }
+                }
+            }
+            true
+        };
+        if !count(own) {
+            return n;
+        }
+        // The voxels of the ball's box, the radius padded beyond what the
+        // `f32` distance test can accept (voxel coordinates as `voxelise`
+        // computes them, which is monotone in each coordinate).
+        let inv = 1.0 / self.side;
+        let pad = r * (1.0 + 1e-6);
+        let at = |k: usize, d: f64| floor_i64((q[k] as f64 + d) * inv);
+        let (lo, hi) = (
+            [0, 1, 2].map(|k| at(k, -pad)),
+            [0, 1, 2].map(|k| at(k, pad)),
+        );
+        for z in lo[2]..=hi[2] {
+            for y in lo[1]..=hi[1] {
+                for x in lo[0]..=hi[0] {
+                    match self.voxels.ids.get([x, y, z]) {
+                        Some(id) if id != own && !count(id) => return n,
+                        _ => {}
+                    }
+                }
+            }
+        }
+        n
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::{floor_i64, voxelise, Buckets, VoxelIds};
@@ -624,5 +697,37 @@ mod tests {
             assert_eq!(floor_i64(x), libm::floor(x) as i64, "{x}");
         }
         assert_eq!(floor_i64(f64::NAN), 0);
+    }
+
+    /// Counting neighbours in a grid agrees with counting them all, for
+    /// voxels as wide as the radius and wider, up to the stop.
+    #[test]
+    fn grid_neighbours_match_a_full_count() {
+        let mut rng = crate::rng::Rng::new(11);
+        let f = |r: &mut crate::rng::Rng| r.below(6_000) as f32 * 1e-3 - 3.0;
+        let pts: Vec<Vec3> = (0..3000)
+            .map(|_| Vec3::new(f(&mut rng), f(&mut rng), f(&mut rng) * 0.2))
+            .collect();
+        let r = 0.3;
+        for side in [0.3, 0.45, 1.0, 2.5] {
+            let grid = super::VoxelGrid::new(&pts, side);
+            for i in (0..pts.len()).step_by(7) {
+                let all = pts
+                    .iter()
+                    .enumerate()
+                    .filter(|&(j, q)| j != i && (*q - pts[i]).length_squared() <= (r * r) as f32)
+                    .count();
+                assert_eq!(
+                    grid.neighbours_up_to(&pts, i, r, usize::MAX - 1),
+                    all,
+                    "side {side}"
+                );
+                assert_eq!(
+                    grid.neighbours_up_to(&pts, i, r, 4),
+                    all.min(5),
+                    "side {side}"
+                );
+            }
+        }
     }
 }

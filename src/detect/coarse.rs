@@ -15,8 +15,8 @@
 //!
 //! [`CascadePolicy::coarse_pass`]: super::CascadePolicy::coarse_pass
 
-use super::{Detection, Detector, Progress, Seen, NO_PRIMITIVE};
-use crate::hash::{voxelise, Buckets};
+use super::{Detection, Detector, PlanePool, Progress, Seen, NO_PRIMITIVE};
+use crate::hash::VoxelGrid;
 use crate::params::Params;
 use crate::primitive::Primitive;
 use crate::rng::Rng;
@@ -56,41 +56,22 @@ fn coarser(p: &Params) -> Params {
 /// than a surface sampled at one point per footprint cell `c` would have
 /// (pi r^2 / c^2, rounded down: 19 with the defaults). Below that density
 /// the first pass's footprint has a hole in most cells, and its clustering
-/// breaks.
-fn sparse_leftovers(pts: &[Vec3], labels: &[u32], p: &Params) -> Vec<u32> {
+/// breaks. Neighbours are counted in `grid` (the first pass's sampling
+/// voxels) when its voxels are at least `r` wide, else in voxels of `r`.
+fn sparse_leftovers(pts: &[Vec3], labels: &[u32], grid: &VoxelGrid, p: &Params) -> Vec<u32> {
     let (r, c) = (p.other.cluster_tolerance, p.other.cell);
     // Counting stops past `most`, which bounds the work in dense places.
     // (Validated parameters: `r` in (0, 1000], `c` at least 0.01 m.)
     let most = (std::f64::consts::PI * (r / c) * (r / c)) as usize;
-    let vox = voxelise(pts, r);
-    let buckets = Buckets::new(&vox.cell_of, vox.coords.len());
-    let r2 = (r * r) as f32;
-    let sparse = |i: usize| -> bool {
-        let c = vox.coords[vox.cell_of[i] as usize];
-        let q = pts[i];
-        let mut n = 0usize;
-        // The 27 voxels of the block around its own, its own first (the
-        // block's centre, 13): most neighbours are there, so a dense point
-        // is told after a few comparisons.
-        for k in 0..27 {
-            let d = (k + 13) % 27;
-            let v = [c[0] + d % 3 - 1, c[1] + d / 3 % 3 - 1, c[2] + d / 9 - 1];
-            let Some(id) = vox.ids.get(v) else {
-                continue;
-            };
-            for &j in buckets.of(id as usize) {
-                if j as usize != i && (pts[j as usize] - q).length_squared() <= r2 {
-                    n += 1;
-                    if n > most {
-                        return false;
-                    }
-                }
-            }
-        }
-        true
+    let own;
+    let grid = if grid.side >= r {
+        grid
+    } else {
+        own = VoxelGrid::new(pts, r);
+        &own
     };
     (0..pts.len())
-        .filter(|&i| labels[i] == NO_PRIMITIVE && sparse(i))
+        .filter(|&i| labels[i] == NO_PRIMITIVE && grid.neighbours_up_to(pts, i, r, most) <= most)
         .map(|i| i as u32)
         .collect()
 }
@@ -102,6 +83,7 @@ pub(super) fn pass(
     first: &Detector,
     out: &mut Detection,
     seen: Seen,
+    grid: &VoxelGrid,
     rng: Rng,
     progress: &mut dyn FnMut(&Progress) -> ControlFlow<()>,
 ) -> bool {
@@ -116,7 +98,7 @@ pub(super) fn pass(
         max_work: p.max_work.saturating_sub(out.work),
         ..coarser(p)
     };
-    let sparse = sparse_leftovers(pts, &out.labels, p);
+    let sparse = sparse_leftovers(pts, &out.labels, grid, p);
     if sparse.len() < q.min_inliers {
         return false;
     }
@@ -126,14 +108,16 @@ pub(super) fn pass(
         pts: &points,
         ..seen
     };
-    let (more, stopped) = Detector::new(&q, first.policy).rounds(sub, rng, &mut |at| {
-        progress(&Progress {
-            round: rounds + at.round,
-            points_left: at.points_left,
-            points: pts.len(),
-            primitives: found + at.primitives,
-        })
-    });
+    let sub_grid = PlanePool::grid(&points, q.sample_radius);
+    let (more, stopped, _) =
+        Detector::new(&q, first.policy).rounds(sub, sub_grid, rng, &mut |at| {
+            progress(&Progress {
+                round: rounds + at.round,
+                points_left: at.points_left,
+                points: pts.len(),
+                primitives: found + at.primitives,
+            })
+        });
     let base = found as u32;
     for (&i, &l) in sparse.iter().zip(&more.labels) {
         if l != NO_PRIMITIVE {
@@ -188,8 +172,12 @@ mod tests {
                 labels[i] = 0;
             }
         }
-        let left = sparse_leftovers(&pts, &labels, &p);
         let want: Vec<u32> = (0..sparse.len() as u32).collect();
-        assert_eq!(left, want);
+        // On the sampling voxels (1 m), and on voxels narrower than the
+        // clustering tolerance, which it then does not count in.
+        for side in [p.sample_radius, 0.3] {
+            let left = sparse_leftovers(&pts, &labels, &PlanePool::grid(&pts, side), &p);
+            assert_eq!(left, want, "voxels of {side} m");
+        }
     }
 }

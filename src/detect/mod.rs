@@ -20,6 +20,7 @@ use crate::clock;
 use crate::cloud::Cloud;
 use crate::error::Result;
 use crate::floor::{sensor_could_stand_at, FloorGrid, GroundRule};
+use crate::hash::VoxelGrid;
 use crate::params::Params;
 use crate::primitive::Primitive;
 use crate::rng::Rng;
@@ -291,14 +292,16 @@ impl<'p> Detector<'p> {
             viewpoint,
             ground,
         };
-        let (mut out, stopped) = self.rounds(seen, rng, progress);
+        let grid = PlanePool::grid(pts, p.sample_radius);
+        let (mut out, stopped, grid) = self.rounds(seen, grid, rng, progress);
         if stopped {
             return (out, true);
         }
         // 7. A coarser cascade on the points too sparse for this one.
-        if policy.coarse_pass && coarse::pass(self, &mut out, seen, coarse_rng, progress) {
+        if policy.coarse_pass && coarse::pass(self, &mut out, seen, &grid, coarse_rng, progress) {
             return (out, true);
         }
+        drop(grid);
         // 8. Merge the pieces of one surface that rounds or passes found
         //    apart.
         if policy.merge_pieces && p.hull.merges_detected_pieces() {
@@ -327,13 +330,16 @@ impl<'p> Detector<'p> {
     }
 
     /// The rounds of the cascade (steps 1-6) on `pts` until a stop rule,
-    /// with `progress` called after each; the flag: stopped by `progress`.
+    /// with `progress` called after each, sampling in `grid`
+    /// ([`PlanePool::grid`] of `pts`); the flag: stopped by `progress`. The
+    /// grid comes back for the coarse pass to count neighbours in.
     fn rounds(
         &self,
         seen: Seen,
+        grid: VoxelGrid,
         rng: Rng,
         progress: &mut dyn FnMut(&Progress) -> ControlFlow<()>,
-    ) -> (Detection, bool) {
+    ) -> (Detection, bool, VoxelGrid) {
         let Seen {
             pts,
             origin,
@@ -351,9 +357,9 @@ impl<'p> Detector<'p> {
         };
         let t0 = clock::now_ms();
         let local_viewpoint = viewpoint - origin;
-        let mut pool = PlanePool::new(
+        let mut pool = PlanePool::on_grid(
             pts,
-            p.sample_radius,
+            grid,
             policy.skip_edge_on_hypotheses.then_some(local_viewpoint),
             rng,
         )
@@ -544,11 +550,11 @@ impl<'p> Detector<'p> {
                 primitives: out.primitives.len(),
             };
             if progress(&at).is_break() {
-                return (out, true);
+                return (out, true, pool.into_grid());
             }
         }
         out.work = pool.work;
         out.time_ms = clock::now_ms() - t0;
-        (out, false)
+        (out, false, pool.into_grid())
     }
 }

@@ -55,7 +55,7 @@ use super::kernels::{self, PlaneF32};
 use crate::floor::GroundRule;
 use crate::geometry::plane::{robust_fit, smallest_eigen3, Moments};
 use crate::geometry::Plane;
-use crate::hash::Buckets;
+use crate::hash::VoxelGrid;
 use crate::params::Params;
 use crate::rng::Rng;
 use glam::{DVec3, Vec3};
@@ -98,7 +98,7 @@ impl LocalPlane {
 /// The points not yet explained, and the sampling structures over them.
 ///
 /// Points are known by their *position*: their rank in voxel order
-/// (`voxels.items[v]` is the original index of position `v`). Per-point
+/// (`grid.members.items[v]` is the original index of position `v`). Per-point
 /// state lives in position order, so what one round touches (the inliers of
 /// one plane, collected voxel by voxel) is close together in memory; only
 /// labels go back to original indices.
@@ -115,8 +115,9 @@ pub struct PlanePool {
     ridx: Vec<u32>,
     /// Per position: its voxel.
     cell_of: Vec<u32>,
-    /// Original indices grouped by voxel.
-    voxels: Buckets,
+    /// The sampling voxels: `grid.members` holds the original indices
+    /// grouped by voxel (position `v` is `grid.members.items[v]`).
+    grid: VoxelGrid,
     /// Coordinates by position (NaN once dead): the full inlier collection
     /// reads only the voxels a plane's slab crosses.
     cell_pts: Vec<Vec3>,
@@ -181,10 +182,22 @@ const POOL_CAP: usize = 1 << 18;
 const LO_SAMPLE: usize = 16_384;
 
 impl PlanePool {
-    /// All of `pts` in play, shuffled once with `rng`. With `edge_on` (the
-    /// sensor in the points' coordinates), planes seen edge-on from it are
-    /// never hypotheses.
-    pub fn new(pts: &[Vec3], sample_radius: f64, edge_on: Option<DVec3>, mut rng: Rng) -> Self {
+    /// All of `pts` in play, shuffled once with `rng`, in sampling voxels of
+    /// side `sample_radius`. With `edge_on` (the sensor in the points'
+    /// coordinates), planes seen edge-on from it are never hypotheses.
+    pub fn new(pts: &[Vec3], sample_radius: f64, edge_on: Option<DVec3>, rng: Rng) -> Self {
+        Self::on_grid(pts, Self::grid(pts, sample_radius), edge_on, rng)
+    }
+
+    /// The sampling voxels of `pts` for [`PlanePool::on_grid`]: side
+    /// `sample_radius` (at least 1 mm).
+    pub fn grid(pts: &[Vec3], sample_radius: f64) -> VoxelGrid {
+        VoxelGrid::new(pts, sample_radius.max(1e-3))
+    }
+
+    /// [`PlanePool::new`] on sampling voxels already built
+    /// ([`PlanePool::grid`]), which [`PlanePool::into_grid`] gives back.
+    pub fn on_grid(pts: &[Vec3], grid: VoxelGrid, edge_on: Option<DVec3>, mut rng: Rng) -> Self {
         let n = pts.len();
         // The scoring pool: every point in random order, or beyond POOL_CAP
         // points a uniform random subset of POOL_CAP; every prefix is a
@@ -199,9 +212,8 @@ impl PlanePool {
             random_prefix(&mut order, POOL_CAP, &mut rng);
         }
         // Sampling voxels (ids in first-seen order of the original indices).
-        let voxels = crate::hash::voxelise(pts, sample_radius.max(1e-3));
-        let cells = voxels.coords.len();
-        let buckets = Buckets::new(&voxels.cell_of, cells);
+        let cells = grid.voxels.coords.len();
+        let buckets = &grid.members;
         let cell_pts: Vec<Vec3> = buckets.items.iter().map(|&i| pts[i as usize]).collect();
         let mut cell_pos_of = vec![0u32; n];
         for (pos, &i) in buckets.items.iter().enumerate() {
@@ -270,7 +282,7 @@ impl PlanePool {
             rz: Vec::new(),
             ridx: Vec::new(),
             cell_of,
-            voxels: buckets,
+            grid,
             rng,
             near,
             min_fatness: 0.0,
@@ -323,9 +335,14 @@ impl PlanePool {
         params.max_hypotheses.saturating_mul(self.hypothesis_scale)
     }
 
+    /// The sampling voxels it was built on.
+    pub fn into_grid(self) -> VoxelGrid {
+        self.grid
+    }
+
     /// Original index of position `v`.
     pub fn original(&self, v: u32) -> u32 {
-        self.voxels.items[v as usize]
+        self.grid.members.items[v as usize]
     }
 
     /// Number of points still in play.
@@ -430,7 +447,8 @@ impl PlanePool {
             let flat = self.voxel_plane(c).is_none_or(|(var, _)| var <= max_var);
             if !flat {
                 out.extend(
-                    self.voxels
+                    self.grid
+                        .members
                         .range(c)
                         .filter(|&pos| self.alive[pos])
                         .map(|pos| pos as u32),
@@ -447,7 +465,7 @@ impl PlanePool {
     /// defined (see [`smallest_eigen3`]).
     fn voxel_plane(&self, c: usize) -> Option<(f64, DVec3)> {
         let mut m = Moments::new(self.cell_box[c].0);
-        for pos in self.voxels.range(c).filter(|&pos| self.alive[pos]) {
+        for pos in self.grid.members.range(c).filter(|&pos| self.alive[pos]) {
             m.push(self.cell_pts[pos].as_dvec3());
         }
         smallest_eigen3(m.covariance()).map(|(l, v)| (l[0], v))
@@ -685,7 +703,7 @@ impl PlanePool {
     /// Judged on at most 64 of its members (an even stride): near the sensor
     /// a voxel holds thousands of points, and an estimate is all this needs.
     fn locally_planar(&mut self, plane: &LocalPlane, cell: usize) -> bool {
-        let members = self.voxels.range(cell);
+        let members = self.grid.members.range(cell);
         let len = members.len();
         let step = len.div_ceil(64).max(1);
         let (n, d, t) = (
@@ -722,7 +740,7 @@ impl PlanePool {
             return None;
         }
         let c = self.cell_of[i1 as usize] as usize;
-        let members = self.voxels.range(c);
+        let members = self.grid.members.range(c);
         // The other two points: a few draws from the first one's voxel,
         // then the first live one there from a random place on
         // (`local_triples`), or any point of the cloud.
@@ -850,7 +868,7 @@ impl PlanePool {
             if (plane.normal.dot(centre) + plane.offset).abs() > reach {
                 continue;
             }
-            let range = self.voxels.range(c);
+            let range = self.grid.members.range(c);
             let lo = range.start;
             self.work += range.len() as u64;
             for (k, p) in self.cell_pts[range].iter().enumerate() {
