@@ -298,11 +298,15 @@ fn absorb(
     }
     let mut now = std::mem::take(&mut members[big]);
     now.retain(|&i| labels[i as usize] == big as u32);
+    // The pieces' points that stay, in increasing order as `taken` holds
+    // them: merged into `big`'s in one pass (sorting the two runs again
+    // took 10 ms of a 1.2M-point location's merge pass).
+    let mut joined = Vec::with_capacity(taken.len());
     for (&(i, _), &stay) in taken.iter().zip(&kept) {
         if stay {
             labels[i] = big as u32;
             out.support += 1;
-            now.push(i as u32);
+            joined.push(i as u32);
         } else {
             labels[i] = NO_PRIMITIVE;
             gone.push(world(i));
@@ -312,8 +316,7 @@ fn absorb(
         gone.push(world(i));
     }
     out.support = out.support.saturating_sub(own_out.len() as u64);
-    now.sort_unstable();
-    members[big] = now;
+    members[big] = merge_sorted(&now, &joined);
     for &j in group {
         members[j].clear();
     }
@@ -324,10 +327,34 @@ fn absorb(
     Ok(out)
 }
 
+/// The union of two increasing lists with no element in both, increasing.
+fn merge_sorted(a: &[u32], b: &[u32]) -> Vec<u32> {
+    let mut out = vec![0u32; a.len() + b.len()];
+    let (mut i, mut j) = (0, 0);
+    for slot in &mut out {
+        // Take from `a` while it has the smaller head (or `b` is done).
+        let from_a = j == b.len() || a.get(i).is_some_and(|&x| x < b[j]);
+        *slot = if from_a { a[i] } else { b[j] };
+        i += usize::from(from_a);
+        j += usize::from(!from_a);
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::floor::GroundRule;
+
+    #[test]
+    fn two_increasing_lists_merge_in_order() {
+        assert_eq!(
+            merge_sorted(&[1, 4, 9], &[2, 3, 10, 11]),
+            [1, 2, 3, 4, 9, 10, 11]
+        );
+        assert_eq!(merge_sorted(&[5, 6], &[]), [5, 6]);
+        assert_eq!(merge_sorted(&[], &[0, 7]), [0, 7]);
+    }
     use crate::geometry::polygon::distance;
     use crate::primitive::{shape, ShapeRules};
 
