@@ -57,14 +57,16 @@ fn coarser(p: &Params) -> Params {
 /// (pi r^2 / c^2, rounded down: 19 with the defaults). Below that density
 /// the first pass's footprint has a hole in most cells, and its clustering
 /// breaks. Neighbours are counted in `grid` (the first pass's sampling
-/// voxels) when its voxels are at least `r` wide, else in voxels of `r`.
+/// voxels) when its voxels are `r` to `2 r` wide (the defaults: 1 m and
+/// 0.5 m), else in voxels of `r`: in wider ones a sparse point would read
+/// ever more points that lie too far.
 fn sparse_leftovers(pts: &[Vec3], labels: &[u32], grid: &VoxelGrid, p: &Params) -> Vec<u32> {
     let (r, c) = (p.other.cluster_tolerance, p.other.cell);
     // Counting stops past `most`, which bounds the work in dense places.
     // (Validated parameters: `r` in (0, 1000], `c` at least 0.01 m.)
     let most = (std::f64::consts::PI * (r / c) * (r / c)) as usize;
     let own;
-    let grid = if grid.side >= r {
+    let grid = if (r..=2.0 * r).contains(&grid.side) {
         grid
     } else {
         own = VoxelGrid::new(pts, r);
@@ -173,9 +175,10 @@ mod tests {
             }
         }
         let want: Vec<u32> = (0..sparse.len() as u32).collect();
-        // On the sampling voxels (1 m), and on voxels narrower than the
-        // clustering tolerance, which it then does not count in.
-        for side in [p.sample_radius, 0.3] {
+        // On the sampling voxels (1 m), and on voxels narrower or much
+        // wider than the clustering tolerance, which it then does not
+        // count in.
+        for side in [p.sample_radius, 0.3, 5.0] {
             let left = sparse_leftovers(&pts, &labels, &PlanePool::grid(&pts, side), &p);
             assert_eq!(left, want, "voxels of {side} m");
         }
