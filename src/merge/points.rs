@@ -345,6 +345,8 @@ fn merge_sorted(a: &[u32], b: &[u32]) -> Vec<u32> {
 mod tests {
     use super::*;
     use crate::floor::GroundRule;
+    use crate::geometry::polygon::distance;
+    use crate::primitive::{shape, ShapeRules};
 
     #[test]
     fn two_increasing_lists_merge_in_order() {
@@ -355,8 +357,6 @@ mod tests {
         assert_eq!(merge_sorted(&[5, 6], &[]), [5, 6]);
         assert_eq!(merge_sorted(&[], &[0, 7]), [0, 7]);
     }
-    use crate::geometry::polygon::distance;
-    use crate::primitive::{shape, ShapeRules};
 
     /// Points of a vertical patch in the plane y = `tilt` * z, x in `x0..x1`,
     /// z in 0..2, on a grid of 5 cm shifted by `shift`.
