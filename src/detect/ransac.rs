@@ -53,7 +53,7 @@
 
 use super::kernels::{self, PlaneF32};
 use crate::floor::GroundRule;
-use crate::geometry::plane::{robust_fit, smallest_eigen3, Moments};
+use crate::geometry::plane::{plane_through, robust_fit, smallest_eigen3, Moments};
 use crate::geometry::Plane;
 use crate::hash::VoxelGrid;
 use crate::params::Params;
@@ -768,26 +768,8 @@ impl PlanePool {
             self.cell_pts[i2 as usize].as_dvec3(),
             self.cell_pts[i3 as usize].as_dvec3(),
         );
-        let cr = (p2 - p1).cross(p3 - p1);
-        // std sqrt (a single instruction in wasm; glam with libm calls software):
-        // both are correctly rounded, so the bits are the same.
-        let len = cr.length_squared().sqrt();
-        // Twice the triangle area must exceed 1 cm^2: no near-collinear triples.
-        if len.is_nan() || len <= 1e-4 {
-            return None;
-        }
-        // `len` is the height on the longest side times that side. The
-        // points are finite here (`len` is not NaN): `max` by comparison
-        // (`f64::max` also tests for NaN in wasm).
-        let mut longest = (p2 - p1).length_squared();
-        for side in [(p3 - p1).length_squared(), (p3 - p2).length_squared()] {
-            longest = if side > longest { side } else { longest };
-        }
-        if len < self.min_fatness * longest {
-            return None;
-        }
-        let nrm = cr / len;
-        Some((nrm, -nrm.dot(p1), c))
+        let (nrm, offset) = plane_through(p1, p2, p3, self.min_fatness)?;
+        Some((nrm, offset, c))
     }
 
     /// The scoring pool's coordinates, in pool order.

@@ -392,7 +392,7 @@ const TIGHT_HYPOTHESES: usize = 200;
 /// plane holds all of it: with a band near the surfaces' noise, the larger
 /// surface's plane wins.
 fn tightest_plane(world: &[DVec3], band: f64, rng: &mut crate::rng::Rng) -> Option<Plane> {
-    use crate::geometry::plane::robust_fit;
+    use crate::geometry::plane::{plane_through, robust_fit};
     let every = world.len().div_ceil(5_000).max(1);
     let pts: Vec<DVec3> = world.iter().copied().step_by(every).collect();
     let n = pts.len();
@@ -407,23 +407,12 @@ fn tightest_plane(world: &[DVec3], band: f64, rng: &mut crate::rng::Rng) -> Opti
     let mut best: Option<(usize, Plane)> = None;
     for _ in 0..TIGHT_HYPOTHESES {
         let (a, b, c) = (pts[rng.below(n)], pts[rng.below(n)], pts[rng.below(n)]);
-        let (u, v) = (b - a, c - a);
-        let cross = u.cross(v);
         // Not a sliver: the triangle's height at least a tenth of its
         // longest side.
-        let side = u
-            .length_squared()
-            .max(v.length_squared())
-            .max((c - b).length_squared());
-        let fat = cross.length_squared() > 0.01 * side * side;
-        if !fat {
+        let Some((normal, offset)) = plane_through(a, b, c, 0.1) else {
             continue;
-        }
-        let normal = cross.normalize();
-        let plane = Plane {
-            normal,
-            offset: -normal.dot(a),
         };
+        let plane = Plane { normal, offset };
         let k = held(&plane);
         if best.is_none_or(|(most, _)| k > most) {
             best = Some((k, plane));
