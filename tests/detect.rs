@@ -1440,7 +1440,6 @@ fn with_and_without(
     loc: &polyscene::sim::Location,
     policy: polyscene::detect::CascadePolicy,
 ) -> (polyscene::detect::Detection, polyscene::detect::Detection) {
-    use polyscene::detect::Detector;
     let cloud = Cloud::from_world_f64(&loc.points).unwrap();
     let p = Params {
         viewpoint: Some(loc.viewpoint().to_array()),
@@ -1448,8 +1447,7 @@ fn with_and_without(
     };
     let with = detect(&cloud, &p).unwrap();
     check_invariants(&cloud, &with, &p);
-    let without = Detector::new(&p, policy).run(&cloud.points, cloud.origin, loc.viewpoint());
-    (with, without)
+    (with, run_with(loc, policy))
 }
 
 /// One-shot detection of a location from its mean pose under `policy`.
