@@ -738,7 +738,7 @@ function notRigid(m) {
       dev = Math.max(dev, Math.abs(dot - (a === b ? 1 : 0)));
     }
   }
-  if (dev > 1e-4) return `its rotation part is not orthonormal (max |R^T R - I| = ${dev.toExponential(3)}); scaling or shear is not allowed`;
+  if (dev > 1e-4) return `its rotation part is not orthonormal (max |R^T R - I| = ${dev}); scaling or shear is not allowed`;
   const det = m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2]) + m[8] * (m[1] * m[6] - m[5] * m[2]);
   if (det < 0) return 'its rotation is a reflection (determinant -1)';
   return undefined;

@@ -10,7 +10,7 @@
 //! steps; such input is refused with an error that names the fix (pass
 //! float64, e.g. a `Float64Array`, or move the points near the origin).
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, Sci};
 use glam::{DMat4, DVec3, Vec3};
 
 /// Largest world coordinate accepted (m): beyond any geodetic frame (the
@@ -187,7 +187,7 @@ pub fn check_rigid(m: &DMat4) -> Result<()> {
         .fold(0.0f64, |acc, v| acc.max(v.abs()));
     if dev > 1e-4 {
         return Err(Error::BadPose(format!(
-            "its rotation part is not orthonormal (max |R^T R - I| = {dev:.3e}); \
+            "its rotation part is not orthonormal (max |R^T R - I| = {dev}); \
              scaling or shear is not allowed"
         )));
     }
@@ -419,7 +419,8 @@ fn check_pose(pose: &DMat4) -> Result<DVec3> {
     let t = pose.w_axis.truncate();
     if t.abs().max_element() > MAX_COORDINATE {
         return Err(Error::BadPose(format!(
-            "its translation lies more than {MAX_COORDINATE:e} m from the world origin"
+            "its translation lies more than {} m from the world origin",
+            Sci(MAX_COORDINATE)
         )));
     }
     Ok(t)

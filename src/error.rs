@@ -62,6 +62,28 @@ pub enum Error {
     Invalid(String),
 }
 
+/// A limit in metres as `{:e}` writes a power of ten (`1e9`, `2e9`, `1e5`):
+/// an integer mantissa and exponent, formatted as integers. Other values as
+/// `{}` writes them. The wasm then carries no exponent formatting of floats
+/// (about 2.5 kB of code).
+pub(crate) struct Sci(pub(crate) f64);
+
+impl fmt::Display for Sci {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let x = self.0;
+        if (1.0..1e18).contains(&x) && x.fract() == 0.0 {
+            let (mut m, mut e) = (x as u64, 0);
+            while m % 10 == 0 {
+                m /= 10;
+                e += 1;
+            }
+            write!(f, "{m}e{e}")
+        } else {
+            write!(f, "{x}")
+        }
+    }
+}
+
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
@@ -80,8 +102,9 @@ impl fmt::Display for Error {
             }
             Error::OutOfRange { point, limit } => write!(
                 f,
-                "point {point} lies more than {limit:e} m from the world origin (after the \
-                 pose, for a scan); coordinates are metres"
+                "point {point} lies more than {} m from the world origin (after the \
+                 pose, for a scan); coordinates are metres",
+                Sci(*limit)
             ),
             Error::TooManyPoints { points, limit } => write!(
                 f,
@@ -94,12 +117,12 @@ impl fmt::Display for Error {
                 limit,
             } => write!(
                 f,
-                "point {point} has a coordinate of {value:.6e} m in float32, which holds \
-                 coordinates beyond {:e} m only to {} mm steps or coarser (here {} mm): \
+                "point {point} has a coordinate of {value} m in float32, which holds \
+                 coordinates beyond {} m only to {} mm steps or coarser (here {} mm): \
                  planes would follow the rounding steps. Pass the points as float64 (a \
                  Float64Array in JS, Cloud::from_flat_f64 or Scenario::add_scan_f64 in \
                  Rust; the CLI keeps LAS, PLY and PCD doubles) or move them near the origin",
-                limit,
+                Sci(*limit),
                 f32_step_mm(*limit),
                 f32_step_mm(*value),
             ),
@@ -122,3 +145,18 @@ fn f32_step_mm(x: f64) -> f64 {
 
 /// Shorthand for results with [`Error`].
 pub type Result<T> = std::result::Result<T, Error>;
+
+#[cfg(test)]
+mod tests {
+    use super::Sci;
+
+    #[test]
+    fn limits_read_as_powers_of_ten() {
+        for x in [1e5, 1e9, 2e9, 1.0, 30.0] {
+            assert_eq!(Sci(x).to_string(), format!("{x:e}"));
+        }
+        assert_eq!(Sci(1.5e5).to_string(), "15e4");
+        assert_eq!(Sci(0.25).to_string(), "0.25");
+        assert_eq!(Sci(-1e5).to_string(), "-100000");
+    }
+}

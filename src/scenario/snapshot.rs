@@ -24,6 +24,7 @@
 //! a few cells, plane offsets up to |n . p|) within [`REACH`].
 
 use crate::cloud::MAX_COORDINATE;
+use crate::error::Sci;
 use crate::geometry::polygon::signed_area;
 use crate::params::Params;
 use crate::primitive::Primitive;
@@ -73,10 +74,11 @@ fn within(v: DVec3, bound: f64) -> bool {
 
 /// The plane, frame, outline, moments and footprint of one primitive.
 fn check_geometry(p: &Primitive, params: &Params) -> Result<(), String> {
+    let (reach, max) = (Sci(REACH), Sci(MAX_COORDINATE));
     let plane = &p.plane;
     if !unit(plane.normal) || !plane.offset.is_finite() || plane.offset.abs() > REACH {
         return Err(format!(
-            "its plane (normal {}, offset {}) must have a unit normal and an offset within {REACH:e} m",
+            "its plane (normal {}, offset {}) must have a unit normal and an offset within {reach} m",
             plane.normal, plane.offset
         ));
     }
@@ -89,7 +91,7 @@ fn check_geometry(p: &Primitive, params: &Params) -> Result<(), String> {
         && f.v.dot(f.normal).abs() <= UNIT;
     if !within(f.origin, MAX_COORDINATE) || !orthonormal {
         return Err(format!(
-            "its frame must have an origin within {MAX_COORDINATE:e} m and orthonormal axes"
+            "its frame must have an origin within {max} m and orthonormal axes"
         ));
     }
     let n = p.outline.len();
@@ -102,7 +104,7 @@ fn check_geometry(p: &Primitive, params: &Params) -> Result<(), String> {
     for (i, &q) in p.outline.iter().enumerate() {
         if !q.is_finite() || !within(f.to_world(q), REACH) {
             return Err(format!(
-                "outline vertex {i} ({}, {}) must be finite and lie within {REACH:e} m of the \
+                "outline vertex {i} ({}, {}) must be finite and lie within {reach} m of the \
                  world origin",
                 q.x, q.y
             ));
@@ -124,14 +126,14 @@ fn check_geometry(p: &Primitive, params: &Params) -> Result<(), String> {
     if !finite || !within(m.reference, MAX_COORDINATE) {
         return Err(format!(
             "its moments must be finite, with a count >= 0 and a reference within \
-             {MAX_COORDINATE:e} m"
+             {max} m"
         ));
     }
     if let Some((lo, hi)) = p.footprint.extent() {
         for corner in [lo, hi, DVec2::new(lo.x, hi.y), DVec2::new(hi.x, lo.y)] {
             if !within(f.to_world(corner), REACH) {
                 return Err(format!(
-                    "its footprint reaches ({}, {}) in its frame, beyond {REACH:e} m of the \
+                    "its footprint reaches ({}, {}) in its frame, beyond {reach} m of the \
                      world origin",
                     corner.x, corner.y
                 ));
