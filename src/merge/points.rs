@@ -4,7 +4,7 @@
 
 use super::{boxes_apart, mergeable};
 use crate::geometry::bounds;
-use crate::geometry::plane::Moments;
+use crate::geometry::plane::{robust_fit, Moments, Plane};
 use crate::geometry::polygon::{contains, signed_area};
 use crate::params::Params;
 use crate::primitive::{Primitive, NO_PRIMITIVE};
@@ -201,8 +201,11 @@ fn drop_covered(primitives: &[Primitive], into: &mut [u32], boxes: &[(DVec3, DVe
 /// points on that plane mark its footprint, and one outline trace follows.
 /// Each piece must keep nine tenths of its support within the inlier
 /// distance of the plane and inside the new raster region, and so must the
-/// largest (the larger footprint's trace can simplify another way); the
-/// points that do not lose their label. Labels (and `members`, the points
+/// largest (the larger footprint's trace can simplify another way). A
+/// piece may lose more, up to half, off the plane when those points are a
+/// strip of another surface that tilted its fit (a car's end face beside
+/// its side, a door's jamb): without them it lies on the plane. The points
+/// that do not stay lose their label. Labels (and `members`, the points
 /// of each primitive in increasing order) are changed only on success.
 #[allow(clippy::too_many_arguments)]
 fn absorb(
@@ -261,10 +264,18 @@ fn absorb(
         bad[labels[i] as usize] += (q.is_some() && !stay) as usize;
         kept.push(stay);
     }
+    // A piece with too many points off the plane or outside the region may
+    // still be one surface with a strip of another that tilted it
+    // (`strip_tilted`); the strip then loses its label.
     let failed: Vec<usize> = group
         .iter()
         .copied()
-        .filter(|&j| 10 * bad[j] > total[j])
+        .filter(|&j| {
+            10 * bad[j] > total[j]
+                && !strip_tilted(
+                    j, total[j], primitives, &taken, &kept, labels, pts, origin, &out.plane, p,
+                )
+        })
         .collect();
     if !failed.is_empty() {
         return Err(failed);
@@ -325,6 +336,52 @@ fn absorb(
     }
     out.moments.remove(&gone);
     Ok(out)
+}
+
+/// Is piece `j` (`total` points) one surface with a strip of another that
+/// tilted its fit (a car's end face beside its side, a door's jamb)? Under
+/// half of its points lie off `plane`, at most a tenth of them on it but
+/// outside the new region (`kept` false), and its points on `plane`,
+/// fitted alone (robustly, as shaping fits), stay within `mergeDistance` of it across the piece's
+/// outline (the sine of the angle between the two planes times the
+/// outline's reach from those points' centroid).
+#[allow(clippy::too_many_arguments)]
+#[inline(never)]
+fn strip_tilted(
+    j: usize,
+    total: usize,
+    primitives: &[Primitive],
+    taken: &[(usize, Option<DVec2>)],
+    kept: &[bool],
+    labels: &[u32],
+    pts: &[Vec3],
+    origin: DVec3,
+    plane: &Plane,
+    p: &Params,
+) -> bool {
+    let piece = &primitives[j];
+    let mut on = Vec::new();
+    let mut outside = 0;
+    for (&(i, q), &stay) in taken.iter().zip(kept) {
+        if labels[i] as usize == j && q.is_some() {
+            on.push(origin + pts[i].as_dvec3());
+            outside += !stay as usize;
+        }
+    }
+    if 2 * on.len() < total || 10 * outside > total {
+        return false;
+    }
+    let Some(fit) = robust_fit(&on, piece.moments.reference) else {
+        return false;
+    };
+    let c = piece.frame.to_local(fit.moments.mean());
+    let fit = fit.plane;
+    let reach = piece
+        .outline
+        .iter()
+        .fold(0.0f64, |r, &q| r.max((q - c).length()));
+    let cos = fit.normal.dot(plane.normal).abs().min(1.0);
+    (1.0 - cos * cos).sqrt() * reach <= p.merge_distance
 }
 
 /// The union of two increasing lists with no element in both, increasing.
@@ -556,6 +613,67 @@ mod tests {
         assert!(labels[..na].iter().all(|&l| l == 0));
         assert!(labels[na..na + nt].iter().all(|&l| l == 1));
         assert!(labels[na + nt..].iter().all(|&l| l == 0));
+    }
+
+    /// A car's side (the plane y = 0, seen from y < 0) found whole, and a
+    /// second piece of it that took in a strip of the car's end face (x =
+    /// 6, running into the car): the strip tilts the piece's plane, and a
+    /// tenth of its points lie beyond the inlier distance of the side's.
+    /// The piece merges into the side; the strip's points off the side's
+    /// plane lose their label, the rest join the side.
+    #[test]
+    fn a_piece_tilted_by_a_strip_of_another_surface_merges_without_it() {
+        let p = Params::gpp2();
+        let side = patch(0.0, 6.0, 0.0, 0.0);
+        // The side's points with some noise across it (up to 4 cm: it is
+        // what lets the robust fit keep a strip a few centimetres off).
+        let mut piece: Vec<Vec3> = patch(3.0, 6.0, 0.0, 0.025)
+            .into_iter()
+            .enumerate()
+            .map(|(i, v)| v + Vec3::new(0.0, 0.02 * ((i * 7) % 5) as f32 - 0.04, 0.0))
+            .collect();
+        let mut y = 0.01;
+        while y < 0.2 {
+            for k in 0..80 {
+                piece.push(Vec3::new(6.0, y as f32, 0.0125 + 0.025 * k as f32));
+            }
+            y += 0.01;
+        }
+        // What shaping keeps of it, as detection would hand it on.
+        let view = DVec3::new(2.0, -6.0, 1.5);
+        loop {
+            let rules = ShapeRules::default();
+            let s = shape(
+                DVec3::ZERO,
+                &piece,
+                &p,
+                view,
+                GroundRule::BelowViewpoint,
+                rules,
+            )
+            .unwrap();
+            if s.kept.iter().all(|&k| k) {
+                break;
+            }
+            let mut kept = s.kept.iter();
+            piece.retain(|_| *kept.next().unwrap());
+        }
+        let (mut prims, mut labels, pts) = two(&side, &piece, &p);
+        let off = |v: &Vec3| v.y.abs() >= p.other.distance as f32;
+        let n_off = piece.iter().filter(|v| off(v)).count();
+        assert!(10 * n_off > piece.len(), "{n_off} of {}", piece.len());
+        assert!(2 * n_off < piece.len());
+        let tilt = prims[0].plane.angle_to(&prims[1].plane).to_degrees();
+        assert!(tilt > 1.0, "{tilt}");
+        assert!(mergeable(&prims[0], &prims[1], &p));
+        let plane = prims[0].plane;
+        merge_pieces(&mut prims, &mut labels, &pts, DVec3::ZERO, &p);
+        assert_eq!(prims.len(), 1);
+        assert_eq!(prims[0].plane, plane);
+        assert_eq!(prims[0].support, (pts.len() - n_off) as u64);
+        for (v, &l) in pts.iter().zip(&labels) {
+            assert_eq!(l == NO_PRIMITIVE, off(v), "{v}");
+        }
     }
 
     #[test]
