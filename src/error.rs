@@ -65,7 +65,7 @@ pub enum Error {
 /// A limit in metres as `{:e}` writes a power of ten (`1e9`, `2e9`, `1e5`):
 /// an integer mantissa and exponent, formatted as integers. Other values as
 /// `{}` writes them. The wasm then carries no exponent formatting of floats
-/// (about 2.5 kB of code).
+/// with a precision (about 1.5 kB of code).
 pub(crate) struct Sci(pub(crate) f64);
 
 impl fmt::Display for Sci {

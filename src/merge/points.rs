@@ -342,9 +342,9 @@ fn absorb(
 /// tilted its fit (a car's end face beside its side, a door's jamb)? Under
 /// half of its points lie off `plane`, at most a tenth of them on it but
 /// outside the new region (`kept` false), and its points on `plane`,
-/// fitted alone (robustly, as shaping fits), stay within `mergeDistance` of it across the piece's
-/// outline (the sine of the angle between the two planes times the
-/// outline's reach from those points' centroid).
+/// fitted alone (robustly, as shaping fits), stay within `mergeDistance`
+/// of it across the piece's outline (the sine of the angle between the two
+/// planes times the outline's reach from those points' centroid).
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
 fn strip_tilted(
@@ -617,8 +617,9 @@ mod tests {
 
     /// A car's side (the plane y = 0, seen from y < 0) found whole, and a
     /// second piece of it that took in a strip of the car's end face (x =
-    /// 6, running into the car): the strip tilts the piece's plane, and a
-    /// tenth of its points lie beyond the inlier distance of the side's.
+    /// 6, running into the car): the strip tilts the piece's plane, and
+    /// more than a tenth of its points lie beyond the inlier distance of the
+    /// side's.
     /// The piece merges into the side; the strip's points off the side's
     /// plane lose their label, the rest join the side.
     #[test]
