@@ -267,13 +267,18 @@ fn absorb(
     // A piece with too many points off the plane or outside the region may
     // still be one surface with a strip of another that tilted it
     // (`strip_tilted`); the strip then loses its label.
+    // The strip test fits the points within the larger piece's own noise
+    // of its plane (as expansion's gate: three times its RMS, at least 3
+    // cm), where a strip's points near the plane weigh least.
+    let gate = (3.0 * out.rms()).max(0.03).min(threshold);
     let failed: Vec<usize> = group
         .iter()
         .copied()
         .filter(|&j| {
             10 * bad[j] > total[j]
                 && !strip_tilted(
-                    j, total[j], primitives, &taken, &kept, labels, pts, origin, &out.plane, p,
+                    j, total[j], bad[j], primitives, &taken, labels, pts, origin, &out.plane, gate,
+                    p,
                 )
         })
         .collect();
@@ -338,50 +343,58 @@ fn absorb(
     Ok(out)
 }
 
-/// Is piece `j` (`total` points) one surface with a strip of another that
-/// tilted its fit (a car's end face beside its side, a door's jamb)? Under
-/// half of its points lie off `plane`, at most a tenth of them on it but
-/// outside the new region (`kept` false), and its points on `plane`,
-/// fitted alone (robustly, as shaping fits), stay within `mergeDistance`
-/// of it across the piece's outline (the sine of the angle between the two
-/// planes times the outline's reach from those points' centroid).
+/// Is piece `j` (`total` points, `bad` of them off `plane` or on it but
+/// outside the new region) one surface with a strip of another that tilted
+/// its fit (a car's end face beside its side, a door's jamb)? Under half of
+/// its points lie off `plane`, at most a tenth on it but outside the new
+/// region, and its points within `gate` of `plane`, fitted alone
+/// (robustly, as shaping fits), stay within `mergeDistance` of it across
+/// the piece's outline (the sine of the angle between the two planes times
+/// the outline's reach from those points' centroid).
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
 fn strip_tilted(
     j: usize,
     total: usize,
+    bad: usize,
     primitives: &[Primitive],
     taken: &[(usize, Option<DVec2>)],
-    kept: &[bool],
     labels: &[u32],
     pts: &[Vec3],
     origin: DVec3,
     plane: &Plane,
+    gate: f64,
     p: &Params,
 ) -> bool {
     let piece = &primitives[j];
-    let mut on = Vec::new();
-    let mut outside = 0;
-    for (&(i, q), &stay) in taken.iter().zip(kept) {
+    let mut on = 0;
+    let mut near = Vec::new();
+    for &(i, q) in taken {
         if labels[i] as usize == j && q.is_some() {
-            on.push(origin + pts[i].as_dvec3());
-            outside += !stay as usize;
+            on += 1;
+            let w = origin + pts[i].as_dvec3();
+            if plane.signed_distance(w).abs() <= gate {
+                near.push(w);
+            }
         }
     }
-    if 2 * on.len() < total || 10 * outside > total {
+    // `bad` counts the points off the plane and those on it outside the
+    // region.
+    let outside = bad - (total - on);
+    if 2 * on < total || 10 * outside > total {
         return false;
     }
-    let Some(fit) = robust_fit(&on, piece.moments.reference) else {
+    let Some(fit) = robust_fit(&near, piece.moments.reference) else {
         return false;
     };
     let c = piece.frame.to_local(fit.moments.mean());
-    let fit = fit.plane;
-    let reach = piece
+    let reach_sq = piece
         .outline
         .iter()
-        .fold(0.0f64, |r, &q| r.max((q - c).length()));
-    let cos = fit.normal.dot(plane.normal).abs().min(1.0);
-    (1.0 - cos * cos).sqrt() * reach <= p.merge_distance
+        .fold(0.0f64, |r, &q| r.max((q - c).length_squared()));
+    // Squared: sine^2 = 1 - cosine^2.
+    let cos = fit.plane.normal.dot(plane.normal);
+    (1.0 - cos * cos) * reach_sq <= p.merge_distance * p.merge_distance
 }
 
 /// The union of two increasing lists with no element in both, increasing.
