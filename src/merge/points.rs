@@ -277,7 +277,14 @@ fn absorb(
         .filter(|&j| {
             10 * bad[j] > total[j]
                 && !strip_tilted(
-                    j, total[j], bad[j], primitives, &taken, labels, pts, origin, &out.plane, gate,
+                    &primitives[j],
+                    &members[j],
+                    bad[j],
+                    pts,
+                    origin,
+                    &out.plane,
+                    threshold,
+                    gate,
                     p,
                 )
         })
@@ -343,37 +350,37 @@ fn absorb(
     Ok(out)
 }
 
-/// Is piece `j` (`total` points, `bad` of them off `plane` or on it but
-/// outside the new region) one surface with a strip of another that tilted
-/// its fit (a car's end face beside its side, a door's jamb)? Under half of
-/// its points lie off `plane`, at most a tenth on it but outside the new
-/// region, and its points within `gate` of `plane`, fitted alone
-/// (robustly, as shaping fits), stay within `mergeDistance` of it across
-/// the piece's outline (the sine of the angle between the two planes times
-/// the outline's reach from those points' centroid).
+/// Is `piece` (its points `members`, `bad` of them off `plane`, at
+/// `threshold` or more, or on it but outside the new region) one surface
+/// with a strip of another that tilted its fit (a car's end face beside its
+/// side, a door's jamb)? Under half of its points lie off `plane`, at most
+/// a tenth on it but outside the new region, and its points within `gate`
+/// of `plane`, fitted alone (robustly, as shaping fits), stay within
+/// `mergeDistance` of it across the piece's outline (the sine of the angle
+/// between the two planes times the outline's reach from those points'
+/// centroid).
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
 fn strip_tilted(
-    j: usize,
-    total: usize,
+    piece: &Primitive,
+    members: &[u32],
     bad: usize,
-    primitives: &[Primitive],
-    taken: &[(usize, Option<DVec2>)],
-    labels: &[u32],
     pts: &[Vec3],
     origin: DVec3,
     plane: &Plane,
+    threshold: f64,
     gate: f64,
     p: &Params,
 ) -> bool {
-    let piece = &primitives[j];
+    let total = members.len();
     let mut on = 0;
     let mut near = Vec::new();
-    for &(i, q) in taken {
-        if labels[i] as usize == j && q.is_some() {
+    for &i in members {
+        let w = origin + pts[i as usize].as_dvec3();
+        let d = plane.signed_distance(w).abs();
+        if d < threshold {
             on += 1;
-            let w = origin + pts[i].as_dvec3();
-            if plane.signed_distance(w).abs() <= gate {
+            if d <= gate {
                 near.push(w);
             }
         }
