@@ -148,6 +148,21 @@ pub fn floor_i64(x: f64) -> i64 {
     }
 }
 
+/// `x.clamp(lo, hi)` for `lo <= hi` (NaN stays NaN), without its panic for
+/// `lo > hi` (which then gives `lo`). The panic's message writes the floats
+/// with `{:?}`, and where the bounds are not constants it kept core's
+/// exponent formatting in the wasm.
+#[inline]
+pub(crate) fn clamp(x: f64, lo: f64, hi: f64) -> f64 {
+    if x < lo {
+        lo
+    } else if x > hi {
+        hi
+    } else {
+        x
+    }
+}
+
 /// The bounding box (low, high corners) of `pts`; infinite corners for
 /// none.
 pub(crate) fn bounds(pts: &[glam::DVec3]) -> (glam::DVec3, glam::DVec3) {

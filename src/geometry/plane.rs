@@ -419,7 +419,7 @@ pub fn smallest_eigen3(m: [[f64; 3]; 3]) -> Option<([f64; 3], DVec3)> {
     if !(len > 0.0 && len.is_finite()) {
         return None;
     }
-    Some(([low, mid.clamp(low, top), top], best / len))
+    Some(([low, super::clamp(mid, low, top), top], best / len))
 }
 
 /// Eigen-decomposition of a symmetric 3x3 matrix by cyclic Jacobi rotations.

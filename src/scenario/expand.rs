@@ -62,7 +62,7 @@ pub(crate) fn expand(
     // The gate adapts to how flat this primitive really is.
     let sigma = prim.rms();
     // The 3 cm floor yields to an expandAcross set below it.
-    let across = (3.0 * sigma).clamp(0.03f64.min(max_across), max_across);
+    let across = crate::geometry::clamp(3.0 * sigma, 0.03f64.min(max_across), max_across);
     let n = prim.plane.normal;
     let d_local = prim.plane.offset + n.dot(cloud.origin);
     let verts = prim.vertices();
