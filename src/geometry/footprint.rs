@@ -222,7 +222,8 @@ impl Footprint {
             nx1 = nx1.max(x0 + w);
             ny1 = ny1.max(y0 + h);
             // Amortise: leave a quarter of the size as slack on the growing sides.
-            let (sx, sy) = ((nx1 - nx0) / 4 + 4, (ny1 - ny0) / 4 + 4);
+            // (Both sizes are positive: a shift, not an i128 division.)
+            let (sx, sy) = (((nx1 - nx0) >> 2) + 4, ((ny1 - ny0) >> 2) + 4);
             if lo.0 < x0 {
                 nx0 -= sx;
             }
