@@ -530,17 +530,38 @@ fn closest_key<'a>(key: &str, keys: &'a [String]) -> Option<&'a str> {
         .map(|(_, c)| c.as_str())
 }
 
-/// A serde type error in the words of the options' documentation.
+/// A serde type error in the words of the options' documentation, up to
+/// its " at line ". One scan with prefix tests: `str::replace` and
+/// `str::split` with a string pattern would bring core's two-way string
+/// searcher into the wasm for these few short messages.
 fn plain_serde_message(msg: &str) -> String {
-    let msg = msg.split(" at line ").next().unwrap_or(msg);
-    msg.replace("expected f64", "expected a number")
-        .replace("expected u64", "expected a non-negative integer")
-        .replace("expected usize", "expected a non-negative integer")
-        .replace("expected a boolean", "expected true or false")
-        .replace(
+    const PLAIN: [(&str, &str); 5] = [
+        ("expected f64", "expected a number"),
+        ("expected u64", "expected a non-negative integer"),
+        ("expected usize", "expected a non-negative integer"),
+        ("expected a boolean", "expected true or false"),
+        (
             "expected an array of length 3",
             "expected an array of 3 numbers",
-        )
+        ),
+    ];
+    let mut out = String::with_capacity(msg.len());
+    let mut rest = msg;
+    'scan: while let Some(c) = rest.chars().next() {
+        if rest.starts_with(" at line ") {
+            break;
+        }
+        for (from, to) in PLAIN {
+            if let Some(r) = rest.strip_prefix(from) {
+                out.push_str(to);
+                rest = r;
+                continue 'scan;
+            }
+        }
+        out.push(c);
+        rest = &rest[c.len_utf8()..];
+    }
+    out
 }
 
 #[cfg(test)]
@@ -640,6 +661,33 @@ mod tests {
         let fields = serde_json::to_value(Params::gpp2()).unwrap();
         assert_eq!(keys.len(), fields.as_object().unwrap().len());
         assert!(keys.contains(&"groundExpandAcross".to_string()));
+    }
+
+    #[test]
+    fn serde_messages_are_reworded_up_to_their_position() {
+        // The same text as chained `str::replace` calls give.
+        for msg in [
+            "invalid type: string \"\u{e9}t\u{e9}\", expected f64 at line 1 column 12",
+            "invalid type: integer `1`, expected a boolean",
+            "invalid length 2, expected an array of length 3 at line 1 column 20",
+            "expected usize, expected u64, expected f64",
+            "nothing to reword",
+            "",
+        ] {
+            let plain = msg
+                .split(" at line ")
+                .next()
+                .unwrap()
+                .replace("expected f64", "expected a number")
+                .replace("expected u64", "expected a non-negative integer")
+                .replace("expected usize", "expected a non-negative integer")
+                .replace("expected a boolean", "expected true or false")
+                .replace(
+                    "expected an array of length 3",
+                    "expected an array of 3 numbers",
+                );
+            assert_eq!(plain_serde_message(msg), plain);
+        }
     }
 
     #[test]
