@@ -969,6 +969,58 @@ fn planes_through_the_viewpoint_away_from_it_are_not_surfaces() {
     assert_eq!(flat_at(&detect(&c, &on_floor).unwrap(), 0.0), 1);
 }
 
+/// A cloud gathered from several sensor positions (`detect_from`): a patch
+/// whose plane passes through every one of them is laser rings, dropped;
+/// one that a sensor saw from below is a surface, kept. Seen from nowhere
+/// (no positions) the patch is kept too.
+#[test]
+fn a_map_drops_planes_seen_edge_on_from_every_sensor_only() {
+    use polyscene::detect::detect_from;
+    let mut rng = Rng::new(23);
+    let mut pts = flat_ground(&mut rng);
+    rect(
+        &mut pts,
+        DVec3::new(6.0, -1.5, 1.8),
+        DVec3::X,
+        DVec3::Y,
+        3.0,
+        3.0,
+        0.05,
+        0.0,
+        &mut rng,
+    );
+    let c = cloud(&pts);
+    let p = Params::gpp2();
+    let patches = |det: &polyscene::detect::Detection| {
+        det.primitives
+            .iter()
+            .filter(|q| q.plane.normal.z.abs() > 0.999 && (q.plane.offset.abs() - 1.8).abs() < 0.02)
+            .count()
+    };
+    let level = [DVec3::new(0.0, 0.0, 1.8), DVec3::new(4.0, 0.5, 1.8)];
+    let det = detect_from(&c, &p, &level).unwrap();
+    check_invariants(&c, &det, &p);
+    assert_eq!(patches(&det), 0);
+    assert!(det.primitives.iter().any(|q| q.ground), "the ground stays");
+    let one_higher = [DVec3::new(0.0, 0.0, 1.8), DVec3::new(4.0, 0.5, 2.6)];
+    assert_eq!(patches(&detect_from(&c, &p, &one_higher).unwrap()), 1);
+    assert_eq!(patches(&detect_from(&c, &p, &[]).unwrap()), 1);
+    // Positions and a single viewpoint together, or a position that is no
+    // number, are errors.
+    let both = Params {
+        viewpoint: Some([0.0, 0.0, 1.8]),
+        ..Params::gpp2()
+    };
+    let e = detect_from(&c, &both, &level).unwrap_err().to_string();
+    assert!(e.contains("'viewpoint'"), "{e}");
+    let nan = [DVec3::new(0.0, f64::NAN, 1.8)];
+    let e = detect_from(&c, &p, &nan).unwrap_err().to_string();
+    assert!(
+        e.contains("'viewpoints'") && e.contains("viewpoint 0"),
+        "{e}"
+    );
+}
+
 /// The beam at the sensor's own elevation draws a horizontal ring across
 /// everything around (here vegetation 12 m away, 30,000 points) and a band
 /// across every wall. That plane is seen edge-on: as a candidate it would
@@ -1323,6 +1375,50 @@ fn a_world_frame_location_without_a_viewpoint_keeps_its_ground() {
         precision += m.detection.precision / starts.len() as f64;
     }
     assert!(precision > 0.93, "{precision}");
+}
+
+/// The same locations with the positions of the scans they were gathered
+/// from: the patches of laser rings at the sensors' height (the share of
+/// false positives seen from nowhere) are dropped, and what the map holds
+/// stays.
+#[test]
+fn a_location_with_its_sensor_positions_drops_the_rings_and_keeps_the_map() {
+    use polyscene::detect::detect_from;
+    let (drive, gt) = drive_truth(polyscene::sim::Layout::Street);
+    let p = Params::gpp2();
+    let starts = [10, 20, 30, 40, 50, 60, 70, 80];
+    let (mut precision, mut recall, mut recall_nowhere) = (0.0, 0.0, 0.0);
+    for start in starts {
+        let loc = drive.location(start, 10).unwrap();
+        let cloud = Cloud::from_world_f64(&loc.points).unwrap();
+        let sensors: Vec<DVec3> = (start..start + 10)
+            .map(|k| drive.scan(k).unwrap().pose.w_axis.truncate())
+            .collect();
+        let det = detect_from(&cloud, &p, &sensors).unwrap();
+        check_invariants(&cloud, &det, &p);
+        let m = score_location(&det, &gt, &loc);
+        let nowhere = score_location(&detect(&cloud, &p).unwrap(), &gt, &loc);
+        println!(
+            "scan {start}: precision {:.3} (nowhere {:.3}), recall {:.3} ({:.3}), completeness {:.3} ({:.3})",
+            m.detection.precision,
+            nowhere.detection.precision,
+            m.detection.recall,
+            nowhere.detection.recall,
+            m.completeness.completeness,
+            nowhere.completeness.completeness
+        );
+        assert!(
+            m.completeness.completeness > nowhere.completeness.completeness - 0.01,
+            "scan {start}"
+        );
+        assert_eq!(m.duplicates.count, 0, "scan {start}");
+        precision += m.detection.precision / starts.len() as f64;
+        recall += m.detection.recall / starts.len() as f64;
+        recall_nowhere += nowhere.detection.recall / starts.len() as f64;
+    }
+    println!("precision {precision:.3}, recall {recall:.3} ({recall_nowhere:.3} from nowhere)");
+    assert!(precision > 0.98, "{precision}");
+    assert!(recall > recall_nowhere - 0.02, "{recall} {recall_nowhere}");
 }
 
 /// Without a viewpoint, `detect` says what it went by: the origin for a

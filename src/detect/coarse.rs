@@ -111,15 +111,18 @@ pub(super) fn pass(
         ..seen
     };
     let sub_grid = PlanePool::grid(&points, q.sample_radius);
-    let (more, stopped, _) =
-        Detector::new(&q, first.policy).rounds(sub, sub_grid, rng, &mut |at| {
-            progress(&Progress {
-                round: rounds + at.round,
-                points_left: at.points_left,
-                points: pts.len(),
-                primitives: found + at.primitives,
-            })
-        });
+    let (more, stopped, _) = Detector {
+        sensors: first.sensors,
+        ..Detector::new(&q, first.policy)
+    }
+    .rounds(sub, sub_grid, rng, &mut |at| {
+        progress(&Progress {
+            round: rounds + at.round,
+            points_left: at.points_left,
+            points: pts.len(),
+            primitives: found + at.primitives,
+        })
+    });
     let base = found as u32;
     for (&i, &l) in sparse.iter().zip(&more.labels) {
         if l != NO_PRIMITIVE {

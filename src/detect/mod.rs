@@ -18,7 +18,7 @@ pub use policy::{CascadePolicy, GroundBy};
 
 use crate::clock;
 use crate::cloud::Cloud;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::floor::{sensor_could_stand_at, FloorGrid, GroundRule};
 use crate::hash::VoxelGrid;
 use crate::params::Params;
@@ -83,7 +83,8 @@ pub struct Detection {
     pub time_ms: f64,
     /// The sensor position [`detect`] went by (world, m): `viewpoint` when
     /// given, the origin when it took the cloud for a scan in its own
-    /// frame, `None` when it saw the cloud from nowhere (a map). `None`
+    /// frame, `None` when it saw the cloud from no single viewpoint (a
+    /// map, with or without [`detect_from`]'s sensor positions). `None`
     /// from [`Detector::run`], which is given its viewpoint.
     pub sensor: Option<DVec3>,
 }
@@ -122,7 +123,36 @@ pub struct Detection {
 /// change nothing (the cloud's origin already ignores them). More of them
 /// may be a second site, and all points are searched.
 pub fn detect(cloud: &Cloud, params: &Params) -> Result<Detection> {
-    let found = detect_with_progress(cloud, params, &mut |_| ControlFlow::Continue(()))?;
+    detect_from(cloud, params, &[])
+}
+
+/// [`detect`] of a cloud accumulated from scans whose sensors stood at
+/// `viewpoints` (world, m), with no `params.viewpoint`: the cloud is seen
+/// from no single viewpoint, as [`detect`] sees a map, except that a
+/// candidate whose plane passes through every one of them, away from each,
+/// is dropped as laser rings (the sensors of a drive on level ground all
+/// lie in the plane of the rings at their height, and a patch of those
+/// rings is no surface). A plane seen edge-on from some of them only is
+/// kept: the others saw it face-on. Empty `viewpoints`: [`detect`].
+pub fn detect_from(cloud: &Cloud, params: &Params, viewpoints: &[DVec3]) -> Result<Detection> {
+    if !viewpoints.is_empty() && params.viewpoint.is_some() {
+        return Err(Error::BadOption {
+            key: "viewpoint".into(),
+            reason: "not with the viewpoints of an accumulated cloud: give one or the other".into(),
+        });
+    }
+    if let Some(i) = viewpoints.iter().position(|v| !v.is_finite()) {
+        return Err(Error::BadOption {
+            key: "viewpoints".into(),
+            reason: format!("viewpoint {i} is not finite"),
+        });
+    }
+    let found = detect_inner(
+        cloud,
+        params,
+        viewpoints,
+        &mut |_| ControlFlow::Continue(()),
+    )?;
     // Never stopped, so always `Some`.
     Ok(found.unwrap_or_default())
 }
@@ -136,16 +166,26 @@ pub fn detect_with_progress(
     params: &Params,
     progress: &mut dyn FnMut(&Progress) -> ControlFlow<()>,
 ) -> Result<Option<Detection>> {
+    detect_inner(cloud, params, &[], progress)
+}
+
+/// [`detect_with_progress`] from `viewpoints` ([`detect_from`], checked).
+fn detect_inner(
+    cloud: &Cloud,
+    params: &Params,
+    viewpoints: &[DVec3],
+    progress: &mut dyn FnMut(&Progress) -> ControlFlow<()>,
+) -> Result<Option<Detection>> {
     params.validate()?;
     let Some((median, reach)) =
         crate::cloud::bulk_extent(cloud.points.iter().map(|p| p.as_dvec3()))
     else {
-        return Ok(detect_all(cloud, params, progress));
+        return Ok(detect_all(cloud, params, viewpoints, progress));
     };
     let far = |p: &glam::Vec3| (p.as_dvec3() - median).abs().max_element() > reach;
     let outliers = cloud.points.iter().filter(|p| far(p)).count();
     if outliers >= params.min_inliers {
-        return Ok(detect_all(cloud, params, progress));
+        return Ok(detect_all(cloud, params, viewpoints, progress));
     }
     let kept: Vec<u32> = (0..cloud.len() as u32)
         .filter(|&i| !far(&cloud.points[i as usize]))
@@ -154,7 +194,7 @@ pub fn detect_with_progress(
         origin: cloud.origin,
         points: kept.iter().map(|&i| cloud.points[i as usize]).collect(),
     };
-    let Some(mut det) = detect_all(&bulk, params, progress) else {
+    let Some(mut det) = detect_all(&bulk, params, viewpoints, progress) else {
         return Ok(None);
     };
     let mut labels = vec![NO_PRIMITIVE; cloud.len()];
@@ -181,12 +221,16 @@ fn scattered_spread(accepted_rms: &mut [f64], p: &Params) -> f64 {
 fn detect_all(
     cloud: &Cloud,
     params: &Params,
+    sensors: &[DVec3],
     progress: &mut dyn FnMut(&Progress) -> ControlFlow<()>,
 ) -> Option<Detection> {
     // The given viewpoint, or the origin for a scan in its own frame.
     let sensor = match params.viewpoint {
         Some(v) => Some(DVec3::from_array(v)),
-        None => sensor_could_stand_at(&cloud.points, -cloud.origin).then_some(DVec3::ZERO),
+        None if sensors.is_empty() => {
+            sensor_could_stand_at(&cloud.points, -cloud.origin).then_some(DVec3::ZERO)
+        }
+        None => None,
     };
     let (policy, viewpoint) = match sensor {
         Some(v) => (CascadePolicy::one_shot(), v),
@@ -195,10 +239,14 @@ fn detect_all(
             let n = cloud.points.len().max(1) as f64;
             let mean = cloud.points.iter().map(|p| p.as_dvec3()).sum::<DVec3>() / n;
             let above = cloud.origin + mean + DVec3::new(0.0, 0.0, 1e4);
-            (CascadePolicy::one_shot().without_viewpoint(), above)
+            let policy = CascadePolicy::one_shot().without_viewpoint();
+            (policy.seen_from_all(!sensors.is_empty()), above)
         }
     };
-    let det = Detector::new(params, policy);
+    let det = Detector {
+        sensors,
+        ..Detector::new(params, policy)
+    };
     let rng = Rng::new(params.seed);
     let (found, stopped) = det.run_inner(&cloud.points, cloud.origin, viewpoint, rng, progress);
     (!stopped).then_some(Detection { sensor, ..found })
@@ -237,12 +285,19 @@ struct Seen<'a> {
 pub struct Detector<'p> {
     params: &'p Params,
     policy: CascadePolicy,
+    /// The sensors an accumulated cloud was gathered from
+    /// ([`detect_from`]); empty: the viewpoint alone.
+    sensors: &'p [DVec3],
 }
 
 impl<'p> Detector<'p> {
     /// A detector with these parameters and rules.
     pub fn new(params: &'p Params, policy: CascadePolicy) -> Self {
-        Detector { params, policy }
+        Detector {
+            params,
+            policy,
+            sensors: &[],
+        }
     }
 
     /// Run the cascade on `pts` (local coordinates relative to `origin`).
@@ -390,6 +445,11 @@ impl<'p> Detector<'p> {
         let judge = round::Judge {
             origin,
             viewpoint,
+            edge_on_from: if self.sensors.is_empty() {
+                std::slice::from_ref(&viewpoint)
+            } else {
+                self.sensors
+            },
             ground,
             p,
             policy,

@@ -225,6 +225,17 @@ impl CascadePolicy {
         }
     }
 
+    /// For a cloud gathered from sensor positions that are `known`
+    /// ([`detect_from`](super::detect_from)): candidates seen edge-on from
+    /// every one of them are rejected as laser rings; the other rules stay
+    /// as they are.
+    pub const fn seen_from_all(self, known: bool) -> Self {
+        CascadePolicy {
+            reject_edge_on_candidates: self.reject_edge_on_candidates || known,
+            ..self
+        }
+    }
+
     /// The paper's cascade, as the scenario runs it on the points its
     /// primitives did not explain and on its pool of earlier leftovers:
     /// the largest cluster of each round's plane, fixed clustering

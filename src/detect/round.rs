@@ -171,6 +171,10 @@ pub(crate) struct Judge<'a> {
     pub(crate) origin: DVec3,
     /// The sensor (world).
     pub(crate) viewpoint: DVec3,
+    /// The sensors a candidate seen edge-on from every one of is laser
+    /// rings (with [`CascadePolicy::reject_edge_on_candidates`]): the
+    /// viewpoint, or the sensors of an accumulated cloud.
+    pub(crate) edge_on_from: &'a [DVec3],
     pub(crate) ground: GroundRule<'a>,
     pub(crate) p: &'a Params,
     pub(crate) policy: &'a CascadePolicy,
@@ -206,7 +210,8 @@ impl Judge<'_> {
                 // (Only the pool's smaller least support lets such a
                 // candidate through to here.)
                 && !(s.primitive.support < p.min_inliers as u64 && self.at_ground_depth(s))
-                && !(self.policy.reject_edge_on_candidates && seen_edge_on(s, viewpoint, p))
+                && !(self.policy.reject_edge_on_candidates
+                    && self.edge_on_from.iter().all(|&v| seen_edge_on(s, v, p)))
                 && !(self.policy.reject_domes && s.domed(self.origin, support_pts, viewpoint))
         };
         // The costliest test last, and only when the others passed.

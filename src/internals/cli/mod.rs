@@ -66,8 +66,9 @@ struct DetectArgs {
     #[arg(long, value_name = "3|4")]
     stride: Option<usize>,
     /// Poses (12 numbers a line, world-from-LiDAR) of the scans the cloud
-    /// was accumulated from: the viewpoint is their mean position
-    /// (conflicts with --viewpoint)
+    /// was accumulated from: a candidate seen edge-on from every one of
+    /// their positions is dropped as laser rings; the rest as for a map
+    /// seen from nowhere (conflicts with --viewpoint)
     #[arg(long, value_name = "poses.txt", conflicts_with = "viewpoint")]
     poses: Option<String>,
     /// KITTI calibration: --poses are KITTI camera-0 poses, converted to
@@ -415,17 +416,19 @@ fn read_lidar_poses(path: &str, calib: Option<&str>) -> Result<Vec<glam::DMat4>>
     Ok(crate::io::kitti::lidar_poses(&poses, &tr))
 }
 
-fn detect_cmd(args: DetectArgs, mut params: Params) -> Result<String> {
+fn detect_cmd(args: DetectArgs, params: Params) -> Result<String> {
+    let mut viewpoints = Vec::new();
     if let Some(path) = &args.poses {
         let poses = read_lidar_poses(path, args.calib.as_deref())?;
-        let mean = crate::io::mean_position(&poses)
-            .ok_or_else(|| Error::BadPose(format!("{path}: no poses")))?;
-        params.viewpoint = Some(mean.to_array());
+        if poses.is_empty() {
+            return Err(Error::BadPose(format!("{path}: no poses")));
+        }
+        viewpoints = poses.iter().map(|m| m.w_axis.truncate()).collect();
     }
     let file = read_cloud(&args.cloud, args.stride)?;
     let cloud = file.cloud().map_err(|e| in_file(&args.cloud, e))?;
-    let found = crate::detect::detect(&cloud, &params)?;
-    if params.viewpoint.is_none() {
+    let found = crate::detect::detect_from(&cloud, &params, &viewpoints)?;
+    if params.viewpoint.is_none() && viewpoints.is_empty() {
         eprintln!("polyscene detect: {}", sensor_note(found.sensor));
     }
     let doc = PolygonsJson {
@@ -443,7 +446,7 @@ fn sensor_note(sensor: Option<glam::DVec3>) -> &'static str {
         None => {
             "no --viewpoint: no sensor could have stood at the origin, so the cloud is read as \
              a map seen from nowhere (ground from its local floor, a coarse pass for sparse \
-             surfaces); for a scan in map coordinates give --viewpoint X,Y,Z or --poses FILE"
+             surfaces); for a scan in map coordinates give --viewpoint X,Y,Z, for a map --poses FILE"
         }
     }
 }
