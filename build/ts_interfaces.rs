@@ -351,6 +351,7 @@ fn ts_type(rust: &str, types: &Types) -> String {
         // The binding's input types (src/wasm/convert.rs).
         "Stride" => "3 | 4".into(),
         "Pose" => "Float64Array | Float32Array | number[] | { elements: ArrayLike<number> }".into(),
+        "Positions" => "Float64Array | Float32Array | number[]".into(),
         _ => match types.0.get(rust) {
             Some(t) => t.clone(),
             None => panic!("build.rs: no TypeScript type for the Rust type `{rust}`"),

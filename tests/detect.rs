@@ -608,7 +608,7 @@ fn progress_is_reported_after_each_round_and_can_stop_the_detection() {
     let p = Params::gpp2();
     let plain = detect(&c, &p).unwrap();
     let mut seen: Vec<Progress> = Vec::new();
-    let reported = detect_with_progress(&c, &p, &mut |at| {
+    let reported = detect_with_progress(&c, &p, &[], &mut |at| {
         seen.push(*at);
         ControlFlow::Continue(())
     })
@@ -633,7 +633,7 @@ fn progress_is_reported_after_each_round_and_can_stop_the_detection() {
     assert!(seen.last().unwrap().primitives >= plain.primitives.len());
     // Stopped after the second round: no result, and no third report.
     let mut calls = 0;
-    let stopped = detect_with_progress(&c, &p, &mut |at| {
+    let stopped = detect_with_progress(&c, &p, &[], &mut |at| {
         calls += 1;
         if at.round == 2 {
             ControlFlow::Break(())
@@ -650,7 +650,7 @@ fn progress_is_reported_after_each_round_and_can_stop_the_detection() {
         ..Params::gpp2()
     };
     let mut called = false;
-    assert!(detect_with_progress(&c, &bad, &mut |_| {
+    assert!(detect_with_progress(&c, &bad, &[], &mut |_| {
         called = true;
         ControlFlow::Continue(())
     })

@@ -135,6 +135,27 @@ pub fn detect(cloud: &Cloud, params: &Params) -> Result<Detection> {
 /// rings is no surface). A plane seen edge-on from some of them only is
 /// kept: the others saw it face-on. Empty `viewpoints`: [`detect`].
 pub fn detect_from(cloud: &Cloud, params: &Params, viewpoints: &[DVec3]) -> Result<Detection> {
+    let found = detect_with_progress(
+        cloud,
+        params,
+        viewpoints,
+        &mut |_| ControlFlow::Continue(()),
+    )?;
+    // Never stopped, so always `Some`.
+    Ok(found.unwrap_or_default())
+}
+
+/// [`detect_from`] that calls `progress` after each round of the cascade (the
+/// rounds' count is not known in advance: `points_left` falls towards 0);
+/// [`ControlFlow::Break`] stops it there and gives `Ok(None)`. The result of
+/// a detection that runs to its end is the same as [`detect_from`]'s.
+pub fn detect_with_progress(
+    cloud: &Cloud,
+    params: &Params,
+    viewpoints: &[DVec3],
+    progress: &mut dyn FnMut(&Progress) -> ControlFlow<()>,
+) -> Result<Option<Detection>> {
+    params.validate()?;
     if !viewpoints.is_empty() && params.viewpoint.is_some() {
         return Err(Error::BadOption {
             key: "viewpoint".into(),
@@ -147,36 +168,6 @@ pub fn detect_from(cloud: &Cloud, params: &Params, viewpoints: &[DVec3]) -> Resu
             reason: format!("viewpoint {i} is not finite"),
         });
     }
-    let found = detect_inner(
-        cloud,
-        params,
-        viewpoints,
-        &mut |_| ControlFlow::Continue(()),
-    )?;
-    // Never stopped, so always `Some`.
-    Ok(found.unwrap_or_default())
-}
-
-/// [`detect`] that calls `progress` after each round of the cascade (the
-/// rounds' count is not known in advance: `points_left` falls towards 0);
-/// [`ControlFlow::Break`] stops it there and gives `Ok(None)`. The result of
-/// a detection that runs to its end is the same as [`detect`]'s.
-pub fn detect_with_progress(
-    cloud: &Cloud,
-    params: &Params,
-    progress: &mut dyn FnMut(&Progress) -> ControlFlow<()>,
-) -> Result<Option<Detection>> {
-    detect_inner(cloud, params, &[], progress)
-}
-
-/// [`detect_with_progress`] from `viewpoints` ([`detect_from`], checked).
-fn detect_inner(
-    cloud: &Cloud,
-    params: &Params,
-    viewpoints: &[DVec3],
-    progress: &mut dyn FnMut(&Progress) -> ControlFlow<()>,
-) -> Result<Option<Detection>> {
-    params.validate()?;
     let Some((median, reach)) =
         crate::cloud::bulk_extent(cloud.points.iter().map(|p| p.as_dvec3()))
     else {

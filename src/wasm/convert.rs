@@ -45,6 +45,10 @@ pub type Stride = usize;
 /// A world-from-sensor pose as the binding reads it (see [`pose_of`]).
 pub type Pose = DMat4;
 
+/// Sensor positions as the binding reads them: x, y, z of each, one flat
+/// `Float64Array`, `Float32Array` or `Array` of numbers.
+pub type Positions = Vec<DVec3>;
+
 #[cfg(feature = "wasm-main")]
 /// Options of `new Scenario(options)`: the pipeline options.
 pub struct ScenarioOptions {
@@ -59,6 +63,13 @@ pub struct DetectOptions {
     pub params: Params,
     /// Numbers per point: 3 (x, y, z) or 4 (x, y, z, intensity). Default 3.
     pub stride: Stride,
+    /// Sensor positions of the scans an accumulated cloud (a map, a tile)
+    /// was gathered from (world, m; x, y, z of each, at most 100,000). The
+    /// cloud is then seen from no single viewpoint (as a map is without
+    /// them), except that a candidate whose plane passes through every one
+    /// of them, away from each, is dropped as laser rings. Not with
+    /// `viewpoint`. Default none.
+    pub viewpoints: Positions,
 }
 
 #[cfg(feature = "wasm-main")]
@@ -93,6 +104,8 @@ pub(super) struct Read {
     stride: Stride,
     /// `pose`, default identity.
     pose: Pose,
+    /// `viewpoints`, default none.
+    viewpoints: Positions,
 }
 
 /// Longest key or string value of an options object (UTF-16 units): the
@@ -101,6 +114,9 @@ const MAX_OPTION_CHARS: u32 = 256;
 
 /// Most numbers in an array option value (a pose has 16).
 const MAX_OPTION_NUMBERS: usize = 64;
+
+/// Most sensor positions in `viewpoints`.
+const MAX_VIEWPOINTS: usize = 100_000;
 
 /// The one reader of option objects. `undefined` and `null` are no options;
 /// anything but a plain object is refused. Keys are read in the object's
@@ -114,6 +130,7 @@ pub(super) fn read_options(v: &JsValue, keys: &Keys) -> WasmResult<Read> {
         map: Map::new(),
         stride: 3,
         pose: DMat4::IDENTITY,
+        viewpoints: Vec::new(),
     };
     if v.is_undefined() || v.is_null() {
         return Ok(read);
@@ -147,6 +164,10 @@ pub(super) fn read_options(v: &JsValue, keys: &Keys) -> WasmResult<Read> {
         }
         if own && key == "pose" {
             read.pose = pose_of(&value)?;
+            continue;
+        }
+        if own && key == "viewpoints" {
+            read.viewpoints = positions_of(&value)?;
             continue;
         }
         let json = json_value(&key, &value)?;
@@ -196,13 +217,14 @@ impl DetectOptions {
             v,
             &Keys {
                 what: "detect options",
-                own: &["stride"],
+                own: &["stride", "viewpoints"],
                 closed: None,
             },
         )?;
         Ok(DetectOptions {
             params: Params::from_options(&read.map)?,
             stride: read.stride,
+            viewpoints: read.viewpoints,
         })
     }
 }
@@ -488,10 +510,55 @@ pub(crate) fn points_of(v: &JsValue, stride: Stride) -> WasmResult<Coordinates> 
 /// The cloud and the parameters of a one-shot detection call (`detect`,
 /// `detectFlat`, `detectWithProgress`): the options first (they give the
 /// stride), then the points, read as [`points_of`] reads them.
-pub(crate) fn detect_input(points: &JsValue, options: &JsValue) -> WasmResult<(Cloud, Params)> {
+pub(crate) fn detect_input(
+    points: &JsValue,
+    options: &JsValue,
+) -> WasmResult<(Cloud, Params, Positions)> {
     let options = DetectOptions::from_js(options)?;
     let values = points_of(points, options.stride)?;
-    Ok((values.cloud(options.stride)?, options.params))
+    let cloud = values.cloud(options.stride)?;
+    Ok((cloud, options.params, options.viewpoints))
+}
+
+/// `viewpoints`: x, y, z of each position in one flat list of numbers.
+fn positions_of(v: &JsValue) -> WasmResult<Positions> {
+    const WHAT: &str = "option 'viewpoints'";
+    let whole = |len: usize| {
+        if len % 3 == 0 {
+            Ok(())
+        } else {
+            Err(bad_option(
+                "viewpoints",
+                format!("must hold x, y, z of each position, got {len} numbers"),
+            ))
+        }
+    };
+    let nums = match numbers_of::<f64>(v, WHAT, 3 * MAX_VIEWPOINTS, &whole) {
+        Ok(nums) => nums,
+        Err(NumbersError::Failed(f)) => return Err(f),
+        Err(NumbersError::NotNumber(i, x)) => {
+            return Err(bad_option(
+                "viewpoints",
+                format!("element {i} is not a number (got {})", describe(&x)),
+            )
+            .into())
+        }
+        Err(NumbersError::NotArray) => {
+            return Err(bad_option(
+                "viewpoints",
+                format!(
+                    "expected a Float64Array, Float32Array or Array of numbers \
+                     (x, y, z of each position), got {}",
+                    describe(v)
+                ),
+            )
+            .into())
+        }
+    };
+    Ok(nums
+        .chunks_exact(3)
+        .map(|c| DVec3::new(c[0], c[1], c[2]))
+        .collect())
 }
 
 /// A world-from-sensor pose: 16 numbers in column-major order

@@ -159,8 +159,9 @@ pub fn detect(
     #[wasm_bindgen(unchecked_param_type = "Float32Array | Float64Array")] points: JsValue,
     #[wasm_bindgen(unchecked_optional_param_type = "DetectOptions")] options: Option<JsValue>,
 ) -> WasmResult<Array> {
-    let (cloud, params) = detect_input(&points, &options.unwrap_or(JsValue::UNDEFINED))?;
-    let found = crate::detect::detect(&cloud, &params)?;
+    let (cloud, params, viewpoints) =
+        detect_input(&points, &options.unwrap_or(JsValue::UNDEFINED))?;
+    let found = crate::detect::detect_from(&cloud, &params, &viewpoints)?;
     Ok(polygons_array(&found.primitives))
 }
 

@@ -33,7 +33,7 @@ pub fn detect_with_progress_js(
             "detectWithProgress: onProgress must be a function",
         ));
     }
-    let (cloud, params) = detect_input(&points, &options)?;
+    let (cloud, params, viewpoints) = detect_input(&points, &options)?;
     let mut thrown: Option<JsValue> = None;
     let mut last = 0;
     let mut report = |at: &Progress| {
@@ -47,7 +47,7 @@ pub fn detect_with_progress_js(
             }
         }
     };
-    let found = detect_with_progress(&cloud, &params, &mut report)?;
+    let found = detect_with_progress(&cloud, &params, &viewpoints, &mut report)?;
     if let Some(e) = thrown {
         return Err(Failure::thrown(
             &format!("detectWithProgress: onProgress after round {last}"),

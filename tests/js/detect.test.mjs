@@ -1,7 +1,7 @@
 // One-shot detection on real LiDAR scans and on synthetic scenes with known answers.
 import { test } from "node:test";
 import assert from "node:assert/strict";
-import { ps, realScan, polygonArea, floor } from "./common.mjs";
+import { ps, realScan, polygonArea, floor, throwsError } from "./common.mjs";
 
 function checkPolygon(p, options = {}) {
   assert.equal(Math.hypot(...p.normal).toFixed(9), "1.000000000", "unit normal");
@@ -75,4 +75,35 @@ test("detect: degenerate clouds give empty results, not errors", () => {
   for (const pts of cases) {
     assert.deepEqual(ps.detect(pts), []);
   }
+});
+
+test("detect: a map's sensor positions (viewpoints) drop a patch of laser rings at their height only", () => {
+  // A 20 m x 20 m floor and a 3 m x 3 m patch 1.8 m above it, read as a map
+  // (no sensor could have stood at the origin, on the floor's corner).
+  const ground = floor(100, 0.2, 0);
+  const patch = floor(30, 0.1, 1.8).map((v, i) => (i % 3 === 0 ? v + 12 : i % 3 === 1 ? v + 2 : v));
+  const cloud = new Float32Array(ground.length + patch.length);
+  cloud.set(ground);
+  cloud.set(patch, ground.length);
+  const patches = (found) => found.filter((p) => p.normal[2] > 0.999 && Math.abs(p.offset + 1.8) < 0.02).length;
+  const level = Float64Array.of(2, 3, 1.8, 6, 15, 1.8);
+  const dropped = ps.detect(cloud, { viewpoints: level });
+  assert.equal(patches(dropped), 0);
+  assert.ok(dropped.some((p) => p.ground), "the floor stays");
+  // Seen from below by one of them, or as a map with no positions: kept.
+  assert.equal(patches(ps.detect(cloud, { viewpoints: [2, 3, 1.8, 6, 15, 2.6] })), 1);
+  assert.equal(patches(ps.detect(cloud)), 1);
+  // detectFlat and detectWithProgress read them too.
+  assert.equal(ps.detectFlat(cloud, { viewpoints: level }).ids.length, dropped.length);
+  assert.equal(ps.detectWithProgress(cloud, { viewpoints: level }, () => {}).length, dropped.length);
+  for (const [opts, ...patterns] of [
+    [{ viewpoints: [1, 2] }, /option 'viewpoints'/, /x, y, z/, /2 numbers/],
+    [{ viewpoints: [1, 2, "3"] }, /option 'viewpoints'/, /element 2 is not a number/],
+    [{ viewpoints: [1, NaN, 3] }, /option 'viewpoints'/, /viewpoint 0 is not finite/],
+    [{ viewpoints: "here" }, /option 'viewpoints'/, /Float64Array/],
+    [{ viewpoints: [1, 2, 3], viewpoint: [1, 2, 3] }, /option 'viewpoint'/, /one or the other/],
+  ]) {
+    throwsError(assert, () => ps.detect(cloud, opts), ...patterns);
+  }
+  throwsError(assert, () => new ps.Scenario({ viewpoints: [1, 2, 3] }), /viewpoints/);
 });
