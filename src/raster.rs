@@ -508,7 +508,7 @@ fn dilate_bits(grid: &BitGrid, radius: f64) -> BitGrid {
     let radius = if radius.is_nan() {
         0.0
     } else {
-        crate::geometry::clamp(radius, 0.0, (w + h) as f64)
+        radius.max(0.0).min((w + h) as f64)
     };
     let r = radius.floor() as usize;
     let lim = radius * radius;
