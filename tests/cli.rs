@@ -219,13 +219,31 @@ fn the_command_line_is_consistent() {
     polyscene::internals::cli::command().debug_assert();
 }
 
-/// `--poses` makes the mean position of the poses the viewpoint: the same
-/// polygons as `--viewpoint` at that mean; a bad poses file is an error
-/// naming it, and both options together are refused.
+/// `--poses` gives detection the positions of the poses (as
+/// `--viewpoints` does): a horizontal patch in the plane of every one of
+/// them is dropped as laser rings, one that a position lies above is kept;
+/// a bad poses file is an error naming it, and a list of positions that is
+/// not x, y, z triples or that comes with `--viewpoint` is refused.
 #[test]
-fn poses_give_the_viewpoint_of_an_accumulated_cloud() {
+fn poses_give_the_sensor_positions_of_an_accumulated_cloud() {
     let dir = TempDir::new("poses");
-    let cloud = write_cloud(&dir);
+    // A 12 m floor 1.8 m below the poses, and a 2 m x 2 m patch at their
+    // height, 2-4 m from them.
+    let mut values: Vec<f32> = Vec::new();
+    for i in 0..120 {
+        for j in 0..120 {
+            values.extend([-6.0 + 0.1 * i as f32, -6.0 + 0.1 * j as f32, -1.8, 0.5]);
+        }
+    }
+    for i in 0..40 {
+        for j in 0..40 {
+            values.extend([2.0 + 0.05 * i as f32, 1.0 + 0.05 * j as f32, 0.0, 0.5]);
+        }
+    }
+    let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+    let cloud = dir.0.join("cloud.bin");
+    std::fs::write(&cloud, bytes).unwrap();
+    let cloud = cloud.to_string_lossy().into_owned();
     let poses = dir.0.join("poses.txt");
     std::fs::write(
         &poses,
@@ -233,63 +251,47 @@ fn poses_give_the_viewpoint_of_an_accumulated_cloud() {
     )
     .unwrap();
     let poses = poses.to_string_lossy().into_owned();
-    let by_poses = run(&args(&[
-        "detect", &cloud, "--stride", "4", "--poses", &poses,
-    ]))
-    .unwrap();
-    let by_viewpoint = run(&args(&[
-        "detect",
-        &cloud,
-        "--stride",
-        "4",
-        "--viewpoint",
-        "0,0,0",
-    ]))
-    .unwrap();
+    let detect = |more: &[&str]| {
+        let mut a = vec!["detect", &cloud, "--stride", "4"];
+        a.extend_from_slice(more);
+        run(&args(&a))
+    };
     let strip = |s: &str| {
         let mut v: serde_json::Value = serde_json::from_str(s).unwrap();
         v["timeMs"] = serde_json::Value::Null;
         v
     };
-    assert_eq!(strip(&by_poses), strip(&by_viewpoint));
-    assert!(polygon_count(&by_poses) >= 2);
-    let moved = run(&args(&[
-        "detect",
-        &cloud,
-        "--stride",
-        "4",
-        "--viewpoint",
-        "30,0,-1.8",
-    ]))
-    .unwrap();
-    assert_ne!(
-        strip(&moved),
-        strip(&by_poses),
-        "the viewpoint matters here"
-    );
+    let patches = |s: &str| {
+        let v: serde_json::Value = serde_json::from_str(s).unwrap();
+        v["polygons"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|p| {
+                let (nz, d) = (
+                    p["normal"][2].as_f64().unwrap(),
+                    p["offset"].as_f64().unwrap(),
+                );
+                nz.abs() > 0.999 && d.abs() < 0.05
+            })
+            .count()
+    };
+    let by_poses = detect(&["--poses", &poses]).unwrap();
+    let by_positions = detect(&["--viewpoints", "-1,0,0.1,1,0,-0.1"]).unwrap();
+    assert_eq!(strip(&by_poses), strip(&by_positions));
+    assert_eq!(patches(&by_poses), 0);
+    assert!(polygon_count(&by_poses) >= 1, "the floor stays");
+    let one_above = detect(&["--viewpoints", "-1,0,0.1,1,0,1.5"]).unwrap();
+    assert_eq!(patches(&one_above), 1);
     let bad = dir.0.join("bad.txt");
     std::fs::write(&bad, "1 0 0\n").unwrap();
-    let e = run(&args(&[
-        "detect",
-        &cloud,
-        "--stride",
-        "4",
-        "--poses",
-        &bad.to_string_lossy(),
-    ]))
-    .unwrap_err();
+    let e = detect(&["--poses", &bad.to_string_lossy()]).unwrap_err();
     assert!(e.to_string().contains("bad.txt"), "{e}");
-    assert!(run(&args(&[
-        "detect",
-        &cloud,
-        "--stride",
-        "4",
-        "--poses",
-        &poses,
-        "--viewpoint",
-        "0,0,0"
-    ]))
-    .is_err());
+    let e = detect(&["--viewpoints", "1,2"]).unwrap_err();
+    assert!(e.to_string().contains("'viewpoints'"), "{e}");
+    assert!(detect(&["--poses", &poses, "--viewpoint", "0,0,0"]).is_err());
+    assert!(detect(&["--viewpoints", "0,0,0", "--viewpoint", "0,0,0"]).is_err());
+    assert!(detect(&["--viewpoints", "0,0,0", "--poses", &poses]).is_err());
 }
 
 /// `ondata`: the polygons detected on a cloud lie on it; a polygon far from

@@ -71,6 +71,17 @@ struct DetectArgs {
     /// seen from nowhere (conflicts with --viewpoint)
     #[arg(long, value_name = "poses.txt", conflicts_with = "viewpoint")]
     poses: Option<String>,
+    /// The same from the positions themselves (world, m): x,y,z of each
+    /// scan's sensor (JS `viewpoints`; conflicts with --viewpoint and
+    /// --poses)
+    #[arg(
+        long,
+        value_name = "X,Y,Z,...",
+        value_delimiter = ',',
+        allow_hyphen_values = true,
+        conflicts_with_all = ["viewpoint", "poses"]
+    )]
+    viewpoints: Vec<f64>,
     /// KITTI calibration: --poses are KITTI camera-0 poses, converted to
     /// LiDAR poses with its Tr (Tr^-1 . P . Tr)
     #[arg(long, value_name = "calib.txt", requires = "poses")]
@@ -417,7 +428,20 @@ fn read_lidar_poses(path: &str, calib: Option<&str>) -> Result<Vec<glam::DMat4>>
 }
 
 fn detect_cmd(args: DetectArgs, params: Params) -> Result<String> {
-    let mut viewpoints = Vec::new();
+    if args.viewpoints.len() % 3 != 0 {
+        return Err(Error::BadOption {
+            key: "viewpoints".into(),
+            reason: format!(
+                "must hold x, y, z of each position, got {} numbers",
+                args.viewpoints.len()
+            ),
+        });
+    }
+    let mut viewpoints: Vec<glam::DVec3> = args
+        .viewpoints
+        .chunks_exact(3)
+        .map(|c| glam::DVec3::new(c[0], c[1], c[2]))
+        .collect();
     if let Some(path) = &args.poses {
         let poses = read_lidar_poses(path, args.calib.as_deref())?;
         if poses.is_empty() {
