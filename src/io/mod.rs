@@ -91,8 +91,9 @@ pub fn write_labels(path: &Path, labels: &[u32]) -> Result<()> {
         .map_err(|e| Error::Io(format!("cannot write {}: {e}", path.display())))
 }
 
-/// The mean position of `poses` (world-from-sensor): the viewpoint of a
-/// cloud accumulated from them. `None` for no poses.
+/// The mean position of `poses` (world-from-sensor). `None` for no poses.
+/// For a cloud accumulated from them, give detection every position
+/// ([`crate::detect::detect_from`]) rather than their mean as the viewpoint.
 pub fn mean_position(poses: &[DMat4]) -> Option<DVec3> {
     if poses.is_empty() {
         return None;

@@ -86,8 +86,10 @@ pub struct Location {
 }
 
 impl Location {
-    /// The mean position of the scans' poses: the viewpoint to detect the
-    /// location from.
+    /// The mean position of the scans' poses, a viewpoint to detect the
+    /// location from as if one scan had seen it all. It stands for none of
+    /// them: [`crate::detect::detect_from`] with every pose's position
+    /// judges the location as the map it is.
     pub fn viewpoint(&self) -> DVec3 {
         crate::io::mean_position(&self.poses).unwrap_or(DVec3::ZERO)
     }
