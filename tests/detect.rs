@@ -1016,7 +1016,7 @@ fn a_map_drops_planes_seen_edge_on_from_every_sensor_only() {
     let nan = [DVec3::new(0.0, f64::NAN, 1.8)];
     let e = detect_from(&c, &p, &nan).unwrap_err().to_string();
     assert!(
-        e.contains("'viewpoints'") && e.contains("viewpoint 0"),
+        e.contains("'viewpoints'") && e.contains("position 0"),
         "{e}"
     );
 }

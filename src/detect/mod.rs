@@ -165,7 +165,7 @@ pub fn detect_with_progress(
     if let Some(i) = viewpoints.iter().position(|v| !v.is_finite()) {
         return Err(Error::BadOption {
             key: "viewpoints".into(),
-            reason: format!("viewpoint {i} is not finite"),
+            reason: format!("position {i} is not finite"),
         });
     }
     let Some((median, reach)) =

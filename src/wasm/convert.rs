@@ -57,7 +57,8 @@ pub struct ScenarioOptions {
 }
 
 #[cfg(feature = "wasm-main")]
-/// Options of `detect(points, options)`: the pipeline options plus the point layout.
+/// Options of `detect(points, options)`: the pipeline options plus the point
+/// layout and, for an accumulated cloud, its scans' sensor positions.
 pub struct DetectOptions {
     /// The pipeline options (flattened: `PipelineOptions`).
     pub params: Params,
@@ -529,7 +530,7 @@ fn positions_of(v: &JsValue) -> WasmResult<Positions> {
         } else {
             Err(bad_option(
                 "viewpoints",
-                format!("must hold x, y, z of each position, got {len} numbers"),
+                format!("must be a flat list of x, y, z of each position, got {len} values"),
             ))
         }
     };

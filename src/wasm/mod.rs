@@ -145,9 +145,11 @@ const TS_PIPELINE_OPTIONS: &'static str =
 /// `points`: interleaved x, y, z[, intensity] (`options.stride`, default 3)
 /// in metres, a `Float32Array` (copied once; coordinates within 1e5 m of
 /// the origin) or a `Float64Array` (kept in f64 and re-centred: map
-/// coordinates). `options`: the pipeline
-/// options (`DetectOptions`); `viewpoint` is the sensor position (default
-/// the origin: a scan in its own sensor frame).
+/// coordinates). `options` (`DetectOptions`): the pipeline options, and
+/// `stride`; `viewpoint` is the sensor position of one scan (default: the
+/// origin when a sensor could have stood there, a scan in its own frame;
+/// else none, a map), `viewpoints` the sensor positions of the scans an
+/// accumulated cloud was gathered from.
 ///
 /// Returns the polygons (plain objects owned by JS), `bornScan`/`lastScan`
 /// 0. Throws an `Error` naming the problem on a length not divisible by the

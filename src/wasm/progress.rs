@@ -12,7 +12,7 @@ use js_sys::{Array, Function, Object, Reflect};
 use std::ops::ControlFlow;
 use wasm_bindgen::prelude::*;
 
-/// [`detect`](super::detect) that calls `onProgress({ round, pointsLeft,
+/// `detect` that calls `onProgress({ round, pointsLeft,
 /// points, polygons })` after each round of the cascade (`pointsLeft` falls
 /// towards 0, then, for a cloud seen from nowhere, once more from the
 /// sparse points its coarse pass takes up; the rounds' count is not known

@@ -97,9 +97,10 @@ test("detect: a map's sensor positions (viewpoints) drop a patch of laser rings 
   assert.equal(ps.detectFlat(cloud, { viewpoints: level }).ids.length, dropped.length);
   assert.equal(ps.detectWithProgress(cloud, { viewpoints: level }, () => {}).length, dropped.length);
   for (const [opts, ...patterns] of [
-    [{ viewpoints: [1, 2] }, /option 'viewpoints'/, /x, y, z/, /2 numbers/],
+    [{ viewpoints: [1, 2] }, /option 'viewpoints'/, /flat list of x, y, z/, /2 values/],
+    [{ viewpoints: [[1, 2, 3], [4, 5, 6]] }, /option 'viewpoints'/, /flat list/],
     [{ viewpoints: [1, 2, "3"] }, /option 'viewpoints'/, /element 2 is not a number/],
-    [{ viewpoints: [1, NaN, 3] }, /option 'viewpoints'/, /viewpoint 0 is not finite/],
+    [{ viewpoints: [1, NaN, 3] }, /option 'viewpoints'/, /position 0 is not finite/],
     [{ viewpoints: "here" }, /option 'viewpoints'/, /Float64Array/],
     [{ viewpoints: [1, 2, 3], viewpoint: [1, 2, 3] }, /option 'viewpoint'/, /one or the other/],
   ]) {

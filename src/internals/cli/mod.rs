@@ -432,7 +432,7 @@ fn detect_cmd(args: DetectArgs, params: Params) -> Result<String> {
         return Err(Error::BadOption {
             key: "viewpoints".into(),
             reason: format!(
-                "must hold x, y, z of each position, got {} numbers",
+                "must be a flat list of x, y, z of each position, got {} values",
                 args.viewpoints.len()
             ),
         });
