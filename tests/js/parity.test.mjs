@@ -81,3 +81,30 @@ test("one-shot detect on a real Ouster scan equals the native CLI", { timeout: 1
   const got = ps.detect(realScan(file), { stride: 4 });
   assertSamePolygons(got, want, "detect");
 });
+
+test("one-shot detect of a map with its scans' positions (viewpoints) equals the native CLI's --viewpoints", { timeout: 120_000 }, () => {
+  // Scans 5-14 of the simulated drive, moved to the world frame by their
+  // poses (in f64, then float32 as the file holds them): a 1.2M-point map.
+  const poses = readPoses(path.join(drive, "poses.txt"));
+  const world = [];
+  for (let k = 5; k < SCANS; k++) {
+    const m = poses[k];
+    const bin = fs.readFileSync(path.join(drive, `${String(k).padStart(6, "0")}.bin`));
+    const pts = new Float32Array(bin.buffer, bin.byteOffset, bin.length / 4);
+    for (let i = 0; i < pts.length; i += 4) {
+      const [x, y, z] = [pts[i], pts[i + 1], pts[i + 2]];
+      world.push(m[0] * x + m[4] * y + m[8] * z + m[12], m[1] * x + m[5] * y + m[9] * z + m[13], m[2] * x + m[6] * y + m[10] * z + m[14]);
+    }
+  }
+  const cloud = Float32Array.from(world);
+  const file = path.join(dir, "map.bin");
+  fs.writeFileSync(file, Buffer.from(cloud.buffer));
+  const positions = poses.slice(5, SCANS).flatMap((m) => [m[12], m[13], m[14]]);
+  const out = path.join(dir, "map.json");
+  cli("detect", file, "--stride", "3", "--viewpoints", positions.map(String).join(","), "--out", out);
+  const want = JSON.parse(fs.readFileSync(out, "utf8")).polygons;
+  const got = ps.detect(cloud, { viewpoints: positions });
+  assertSamePolygons(got, want, "detect with viewpoints");
+  // The positions drop polygons here (patches of rings at their height).
+  assert.ok(ps.detect(cloud).length > got.length, "the positions change the result");
+});
