@@ -915,35 +915,39 @@ fn flat_ground(rng: &mut Rng) -> Vec<DVec3> {
 /// location they close into a few m^2 of false surface). Such a candidate
 /// is dropped; the same patch a little higher, and a floor under a sensor
 /// standing on it, are kept.
+/// Flat ground and a 3 m x 3 m horizontal patch at height `z` above it,
+/// 6-9 m from the origin.
+fn patch_over_ground(z: f64, rng: &mut Rng) -> Vec<DVec3> {
+    let mut pts = flat_ground(rng);
+    rect(
+        &mut pts,
+        DVec3::new(6.0, -1.5, z),
+        DVec3::X,
+        DVec3::Y,
+        3.0,
+        3.0,
+        0.05,
+        0.0,
+        rng,
+    );
+    pts
+}
+
+/// How many horizontal primitives lie at height `z`.
+fn flat_at(det: &polyscene::detect::Detection, z: f64) -> usize {
+    det.primitives
+        .iter()
+        .filter(|q| {
+            q.plane.normal.z.abs() > 0.999 && (q.plane.offset * q.plane.normal.z + z).abs() < 0.02
+        })
+        .count()
+}
+
 #[test]
 fn planes_through_the_viewpoint_away_from_it_are_not_surfaces() {
     let mut rng = Rng::new(21);
     let ground = |rng: &mut Rng, pts: &mut Vec<DVec3>| pts.extend(flat_ground(rng));
-    let patch_at = |z: f64, rng: &mut Rng| {
-        let mut pts = Vec::new();
-        ground(rng, &mut pts);
-        rect(
-            &mut pts,
-            DVec3::new(6.0, -1.5, z),
-            DVec3::X,
-            DVec3::Y,
-            3.0,
-            3.0,
-            0.05,
-            0.0,
-            rng,
-        );
-        pts
-    };
-    let flat_at = |det: &polyscene::detect::Detection, z: f64| {
-        det.primitives
-            .iter()
-            .filter(|q| {
-                q.plane.normal.z.abs() > 0.999
-                    && (q.plane.offset * q.plane.normal.z + z).abs() < 0.02
-            })
-            .count()
-    };
+    let patch_at = patch_over_ground;
     let p = Params {
         viewpoint: Some([0.0, 0.0, 1.8]),
         ..Params::gpp2()
@@ -977,26 +981,9 @@ fn planes_through_the_viewpoint_away_from_it_are_not_surfaces() {
 fn a_map_drops_planes_seen_edge_on_from_every_sensor_only() {
     use polyscene::detect::detect_from;
     let mut rng = Rng::new(23);
-    let mut pts = flat_ground(&mut rng);
-    rect(
-        &mut pts,
-        DVec3::new(6.0, -1.5, 1.8),
-        DVec3::X,
-        DVec3::Y,
-        3.0,
-        3.0,
-        0.05,
-        0.0,
-        &mut rng,
-    );
-    let c = cloud(&pts);
+    let c = cloud(&patch_over_ground(1.8, &mut rng));
     let p = Params::gpp2();
-    let patches = |det: &polyscene::detect::Detection| {
-        det.primitives
-            .iter()
-            .filter(|q| q.plane.normal.z.abs() > 0.999 && (q.plane.offset.abs() - 1.8).abs() < 0.02)
-            .count()
-    };
+    let patches = |det: &polyscene::detect::Detection| flat_at(det, 1.8);
     let level = [DVec3::new(0.0, 0.0, 1.8), DVec3::new(4.0, 0.5, 1.8)];
     let det = detect_from(&c, &p, &level).unwrap();
     check_invariants(&c, &det, &p);
