@@ -96,9 +96,9 @@ pub struct Detection {
 /// otherwise (a map, a tile, scans accumulated from many poses) the cloud
 /// is seen from nowhere: the rules that need a viewpoint are off
 /// ([`CascadePolicy::without_viewpoint`]) and ground is decided from the
-/// cloud's local floor. Normals of non-horizontal planes point towards the
-/// viewpoint (without one, towards the cloud's centre), near-horizontal
-/// ones up.
+/// cloud's local floor. Normals face the viewpoint; without one, a point
+/// 10 km above the cloud's centre (near-horizontal ones up, a wall the side
+/// its slight tilt turns up: mostly, not always, towards the centre).
 ///
 /// ```
 /// use polyscene::{cloud::Cloud, detect::detect, params::Params};
