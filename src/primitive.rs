@@ -87,6 +87,16 @@ impl Primitive {
             .map_or(0.0, |(_, vals)| vals[0].max(0.0).sqrt())
     }
 
+    /// The distance from its plane within which a point is this
+    /// primitive's own noise: three times its RMS, at least 3 cm (`cap`
+    /// when that is smaller), at most `cap`. Expansion's perpendicular gate
+    /// (`cap` = `expandAcross`), and the band the merge pass refits a piece
+    /// tilted by a strip of another surface from (`cap` = the inlier
+    /// distance).
+    pub(crate) fn noise_gate(&self, cap: f64) -> f64 {
+        crate::geometry::clamp(3.0 * self.rms(), 0.03f64.min(cap), cap)
+    }
+
     /// Does it pass the acceptance tests on its shape: at least
     /// `min_inliers` support points, area above `min_area`, width above
     /// `min_width`, solidity? (Detection also tests the support's roughness,

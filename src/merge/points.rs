@@ -268,9 +268,9 @@ fn absorb(
     // still be one surface with a strip of another that tilted it
     // (`strip_tilted`); the strip then loses its label.
     // The strip test fits the points within the larger piece's own noise
-    // of its plane (as expansion's gate: three times its RMS, at least 3
-    // cm), where a strip's points near the plane weigh least.
-    let gate = (3.0 * out.rms()).max(0.03).min(threshold);
+    // of its plane (expansion's gate), where a strip's points near the
+    // plane weigh least.
+    let gate = out.noise_gate(threshold);
     let failed: Vec<usize> = group
         .iter()
         .copied()

@@ -59,10 +59,9 @@ pub(crate) fn expand(
 ) -> usize {
     let surface = params.surface(prim.ground);
     let (max_across, along) = (surface.expand_across, surface.expand_along);
-    // The gate adapts to how flat this primitive really is.
-    let sigma = prim.rms();
-    // The 3 cm floor yields to an expandAcross set below it.
-    let across = crate::geometry::clamp(3.0 * sigma, 0.03f64.min(max_across), max_across);
+    // The gate adapts to how flat this primitive really is (the 3 cm floor
+    // yields to an expandAcross set below it).
+    let across = prim.noise_gate(max_across);
     let n = prim.plane.normal;
     let d_local = prim.plane.offset + n.dot(cloud.origin);
     let verts = prim.vertices();
