@@ -395,7 +395,7 @@ impl Shaped {
                 DVec2::new(2.0 * co.x * u.x + co.y * u.y, co.y * u.x + 2.0 * co.z * u.y).length()
             })
             .collect();
-        slope.sort_by(f64::total_cmp);
+        crate::geometry::heap_sort_by(&mut slope, f64::total_cmp);
         slope[slope.len() * 9 / 10] > DOME_SLOPE
     }
 }

@@ -202,7 +202,7 @@ fn scattered_spread(accepted_rms: &mut [f64], p: &Params) -> f64 {
     if accepted_rms.is_empty() {
         return SCATTERED_SPREAD_UNKNOWN * p.other.distance;
     }
-    accepted_rms.sort_by(f64::total_cmp);
+    crate::geometry::heap_sort_by(accepted_rms, f64::total_cmp);
     let median = accepted_rms[accepted_rms.len() / 2];
     (SCATTERED_SPREAD * median).max(SCATTERED_SPREAD_FLOOR * p.other.distance)
 }

@@ -695,7 +695,7 @@ fn fit_face(
     if across.len() < 3 {
         return None;
     }
-    across.sort_by(f64::total_cmp);
+    crate::geometry::heap_sort_by(&mut across, f64::total_cmp);
     let mut at = s.a + normal * across[across.len() / 2];
     let mut points: Vec<u32> = Vec::new();
     for _ in 0..2 {
@@ -838,7 +838,7 @@ fn split(face: &Face, pts: &[Vec3], origin: DVec3, gap: f64, spacing: Spacing) -
     // The cuts: the starts of the gaps wider than allowed between the
     // sorted positions; a point's piece is the number of cuts below it.
     let mut sorted = along.clone();
-    sorted.sort_by(f64::total_cmp);
+    crate::geometry::heap_sort_by(&mut sorted, f64::total_cmp);
     let cuts: Vec<f64> = sorted
         .windows(2)
         .filter(|w| w[1] - w[0] > gap * spacing.scale(face.at + face.dir * (0.5 * (w[0] + w[1]))))
@@ -892,7 +892,7 @@ fn riser(
     // The share of its extent (at least a cell) that its points cover,
     // each the `cell` after it times the spacing at its range.
     let len = (s1 - s0).max(cell);
-    along.sort_by(f64::total_cmp);
+    crate::geometry::heap_sort_by(&mut along, f64::total_cmp);
     let (mut covered, mut end) = (0.0, s0);
     for s in along {
         let b = s + cell * spacing.scale(at + dir * s);

@@ -13,6 +13,8 @@ pub mod ring;
 pub use footprint::{Footprint, Region};
 pub use hull::convex_hull;
 pub use numeric::floor_i64;
-pub(crate) use numeric::{bounds, clamp, grow_box, insertion_sort_by, pull_range, unit_or_zero};
+pub(crate) use numeric::{
+    bounds, clamp, grow_box, heap_sort_by, insertion_sort_by, pull_range, unit_or_zero,
+};
 pub use plane::{Frame, Moments, Plane, UP};
 pub use polygon::Polygon3;
