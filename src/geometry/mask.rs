@@ -20,7 +20,7 @@ pub enum Zone {
 
 /// A polygon's cells and those within `reach` of it (its Minkowski sum with
 /// a disk, on a grid: exact up to one cell diagonal).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct GrownMask {
     origin: DVec2,
     cell: f64,

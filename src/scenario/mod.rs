@@ -154,6 +154,9 @@ pub struct Scenario {
     /// Where the primitives are (derived, rebuilt after a restore).
     #[serde(skip)]
     index: PrimIndex,
+    /// The grown masks of the last scan's expansion (derived).
+    #[serde(skip)]
+    masks: expand::Masks,
 }
 
 impl Scenario {
@@ -169,6 +172,7 @@ impl Scenario {
             correction: DMat4::IDENTITY,
             last_labels: Vec::new(),
             index: PrimIndex::default(),
+            masks: expand::Masks::default(),
         })
     }
 
@@ -273,7 +277,7 @@ impl Scenario {
         }
         if p.expansion && !self.primitives.is_empty() && all > 0 {
             let mut index = ScanIndex::new(&cloud.points, INDEX_VOXEL);
-            let mut scratch = expand::Scratch::default();
+            let mut scratch = expand::Scratch::new(std::mem::take(&mut self.masks));
             // Only the primitives a point of this scan could reach (exact:
             // see `primindex`), in id order.
             let (voxels, side) = index.voxels();
@@ -300,6 +304,7 @@ impl Scenario {
                     report.grown.push(prim.id);
                 }
             }
+            self.masks = scratch.into_masks();
             report.explained_by_expansion = alive[..n].iter().filter(|&&a| !a).count();
         }
         report.time_ms.expansion = clock::now_ms() - te;
