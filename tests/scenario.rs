@@ -476,6 +476,20 @@ fn empty_scans_and_bad_poses() {
 }
 
 #[test]
+fn a_scenario_refuses_a_viewpoint_its_poses_would_override() {
+    let params = Params {
+        viewpoint: Some([1.0, 2.0, 1.8]),
+        ..Params::gpp2()
+    };
+    let e = Scenario::new(params).unwrap_err();
+    assert!(
+        matches!(&e, Error::BadOption { key, .. } if key == "viewpoint"),
+        "{e}"
+    );
+    assert!(e.to_string().contains("pose"), "{e}");
+}
+
+#[test]
 fn memory_is_bounded_by_the_mapped_area_not_the_scans() {
     // The same place seen 60 times: support keeps counting (3x between scan
     // 20 and 60) but polygons, vertices and footprint bytes barely move.

@@ -29,8 +29,8 @@ options! {
     /// null: the origin when a sensor could have stood there (a scan in its
     /// own frame), else none (a map: no rules that need a viewpoint, and a
     /// second pass at three times the scale finds the surfaces the map
-    /// holds too sparsely for the first). The scenario uses each scan's
-    /// pose instead.
+    /// holds too sparsely for the first). A scenario refuses it: it takes
+    /// each scan's sensor position from its pose.
     viewpoint: Option<[f64; 3]> = viewpoint, "m", Check::FiniteOrNull;
     /// Fewest inliers a plane needs, and fewest support points a primitive
     /// needs; the cascade stops when the best plane has fewer. The

@@ -160,9 +160,18 @@ pub struct Scenario {
 }
 
 impl Scenario {
-    /// An empty scenario. Errors on invalid parameters.
+    /// An empty scenario. Errors on invalid parameters, and on a
+    /// `viewpoint`: each scan's sensor position comes from its pose.
     pub fn new(params: Params) -> Result<Self> {
         params.validate()?;
+        if params.viewpoint.is_some() {
+            return Err(Error::BadOption {
+                key: "viewpoint".into(),
+                reason: "one-shot detection's: a scenario takes each scan's sensor position \
+                         from its pose"
+                    .into(),
+            });
+        }
         Ok(Scenario {
             params,
             primitives: Vec::new(),

@@ -107,4 +107,7 @@ test("detect: a map's sensor positions (viewpoints) drop a patch of laser rings 
     throwsError(assert, () => ps.detect(cloud, opts), ...patterns);
   }
   throwsError(assert, () => new ps.Scenario({ viewpoints: [1, 2, 3] }), /viewpoints/);
+  // A scenario takes each scan's sensor position from its pose.
+  throwsError(assert, () => new ps.Scenario({ viewpoint: [1, 2, 3] }), /option 'viewpoint'/, /pose/);
+  new ps.Scenario({ viewpoint: null }).free();
 });
