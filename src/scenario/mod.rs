@@ -167,8 +167,8 @@ impl Scenario {
         if params.viewpoint.is_some() {
             return Err(Error::BadOption {
                 key: "viewpoint".into(),
-                reason: "one-shot detection's: a scenario takes each scan's sensor position \
-                         from its pose"
+                reason: "a scenario takes each scan's sensor position from its pose; \
+                         viewpoint is for one-shot detection"
                     .into(),
             });
         }
