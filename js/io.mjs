@@ -187,6 +187,9 @@ function decodeRaw(bytes, stride, name, format = 'raw') {
   for (let i = 0; i < points.length; i++) {
     if (!Number.isFinite(points[i])) throw ioError(name, `point ${Math.floor(i / stride)} has a NaN or infinite value`);
   }
+  // The array carries its stride (not enumerable): detect and addScan refuse
+  // it without { stride: 4 } instead of reading x, y, z, intensity as x, y, z.
+  if (stride !== 3) Object.defineProperty(points, 'stride', { value: stride });
   return { points, stride, count: points.length / stride, format, name };
 }
 

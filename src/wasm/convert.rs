@@ -62,8 +62,10 @@ pub struct ScenarioOptions {
 pub struct DetectOptions {
     /// The pipeline options (flattened: `PipelineOptions`).
     pub params: Params,
-    /// Numbers per point: 3 (x, y, z) or 4 (x, y, z, intensity). Default 3.
-    pub stride: Stride,
+    /// Numbers per point: 3 (x, y, z) or 4 (x, y, z, intensity). Default 3,
+    /// except that points `polyscene/io` or `polyscene/sim` made with 4 (a
+    /// KITTI `.bin`, a simulated scan) are refused without it.
+    pub stride: Option<Stride>,
     /// Sensor positions of the scans an accumulated cloud (a map, a tile)
     /// was gathered from (world, m; x, y, z of each, at most 100,000). The
     /// cloud is then seen from no single viewpoint (as a map is without
@@ -76,8 +78,10 @@ pub struct DetectOptions {
 #[cfg(feature = "wasm-main")]
 /// Options of `scenario.addScan(points, options)`.
 pub struct ScanOptions {
-    /// Numbers per point: 3 (x, y, z) or 4 (x, y, z, intensity). Default 3.
-    pub stride: Stride,
+    /// Numbers per point: 3 (x, y, z) or 4 (x, y, z, intensity). Default 3,
+    /// except that points `polyscene/io` or `polyscene/sim` made with 4 (a
+    /// KITTI `.bin`, a simulated scan) are refused without it.
+    pub stride: Option<Stride>,
     /// World-from-sensor rigid transform: 16 numbers, column-major (three.js
     /// `Matrix4.elements` order), or an object with such an `elements` array.
     /// Default identity.
@@ -101,8 +105,8 @@ pub(super) struct Keys {
 pub(super) struct Read {
     /// The JSON values of the keys other than `stride` and `pose`.
     pub(super) map: Map<String, Value>,
-    /// `stride`, default 3.
-    stride: Stride,
+    /// `stride`, if given.
+    stride: Option<Stride>,
     /// `pose`, default identity.
     pose: Pose,
     /// `viewpoints`, default none.
@@ -129,7 +133,7 @@ const MAX_VIEWPOINTS: usize = 100_000;
 pub(super) fn read_options(v: &JsValue, keys: &Keys) -> WasmResult<Read> {
     let mut read = Read {
         map: Map::new(),
-        stride: 3,
+        stride: None,
         pose: DMat4::IDENTITY,
         viewpoints: Vec::new(),
     };
@@ -174,7 +178,7 @@ pub(super) fn read_options(v: &JsValue, keys: &Keys) -> WasmResult<Read> {
         let json = json_value(&key, &value)?;
         if own && key == "stride" {
             read.stride = match json.as_u64() {
-                Some(s @ (3 | 4)) => s as usize,
+                Some(s @ (3 | 4)) => Some(s as usize),
                 _ => {
                     return Err(bad_option(
                         "stride",
@@ -473,8 +477,13 @@ fn json_number(key: &str, x: f64) -> Result<Value> {
 /// into wasm memory) stays f32; a `Float64Array` or `Array` of numbers stays
 /// f64, re-centred in f64 by the core before anything becomes f32 (map
 /// coordinates). More than [`MAX_POINTS`] points are refused before anything
-/// is allocated.
-pub(crate) fn points_of(v: &JsValue, stride: Stride) -> WasmResult<Coordinates> {
+/// is allocated. `stride` when given, else [`default_stride`]; the values
+/// come with the stride they were read at.
+pub(crate) fn points_of(v: &JsValue, stride: Option<Stride>) -> WasmResult<(Coordinates, Stride)> {
+    let stride = match stride {
+        Some(s) => s,
+        None => default_stride(v)?,
+    };
     // A length that is no multiple of the stride is refused before the copy.
     let whole = |len: usize| {
         if len % stride == 0 {
@@ -491,7 +500,7 @@ pub(crate) fn points_of(v: &JsValue, stride: Stride) -> WasmResult<Coordinates> 
         _ => numbers_of::<f64>(v, "points", max, &whole).map(Coordinates::F64),
     };
     match read {
-        Ok(values) => Ok(values),
+        Ok(values) => Ok((values, stride)),
         Err(NumbersError::Failed(f)) => Err(f),
         Err(NumbersError::NotNumber(i, x)) => Err(invalid(format!(
             "points: element {i} is not a number (got {})",
@@ -508,6 +517,29 @@ pub(crate) fn points_of(v: &JsValue, stride: Stride) -> WasmResult<Coordinates> 
 }
 
 #[cfg(feature = "wasm-main")]
+/// The stride of points given without one: 3, unless they are a typed array
+/// that `polyscene/io` or `polyscene/sim` marked with another (its own
+/// `stride` property, not enumerable), which is refused: x, y, z, intensity
+/// read as x, y, z make other, wrong points, and often no error (when the
+/// length is a multiple of 3).
+fn default_stride(v: &JsValue) -> WasmResult<Stride> {
+    if js::typed_array(v).is_some() {
+        let mark = js::get(v, "stride").map_err(|e| Failure::thrown("reading points.stride", e))?;
+        if let Some(s) = mark.as_f64().filter(|&s| s != 3.0) {
+            return Err(bad_option(
+                "stride",
+                format!(
+                    "not given, and these points were made with {s} values a point \
+                     (polyscene/io and polyscene/sim mark theirs): pass {{ stride: {s} }}"
+                ),
+            )
+            .into());
+        }
+    }
+    Ok(3)
+}
+
+#[cfg(feature = "wasm-main")]
 /// The cloud and the parameters of a one-shot detection call (`detect`,
 /// `detectFlat`, `detectWithProgress`): the options first (they give the
 /// stride), then the points, read as [`points_of`] reads them.
@@ -516,8 +548,8 @@ pub(crate) fn detect_input(
     options: &JsValue,
 ) -> WasmResult<(Cloud, Params, Positions)> {
     let options = DetectOptions::from_js(options)?;
-    let values = points_of(points, options.stride)?;
-    let cloud = values.cloud(options.stride)?;
+    let (values, stride) = points_of(points, options.stride)?;
+    let cloud = values.cloud(stride)?;
     Ok((cloud, options.params, options.viewpoints))
 }
 

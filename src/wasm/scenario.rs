@@ -102,11 +102,11 @@ impl JsScenario {
         #[wasm_bindgen(unchecked_optional_param_type = "ScanOptions")] options: Option<JsValue>,
     ) -> WasmResult<JsValue> {
         let options = ScanOptions::from_js(&options.unwrap_or(JsValue::UNDEFINED))?;
-        let values = points_of(&points, options.stride)?;
+        let (values, stride) = points_of(&points, options.stride)?;
         let mut scenario = self.get_mut()?;
         let report = match &values {
-            Coordinates::F32(v) => scenario.add_scan(v, options.stride, &options.pose)?,
-            Coordinates::F64(v) => scenario.add_scan_f64(v, options.stride, &options.pose)?,
+            Coordinates::F32(v) => scenario.add_scan(v, stride, &options.pose)?,
+            Coordinates::F64(v) => scenario.add_scan_f64(v, stride, &options.pose)?,
         };
         to_js(&report)
     }

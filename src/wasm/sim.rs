@@ -320,9 +320,16 @@ pub struct ScanView {
 
 impl ScanView {
     fn of(index: usize, scan: &Scan) -> Self {
+        let points = Float32Array::from(&scan.points[..]);
+        // The array carries its stride (not enumerable): detect and addScan
+        // refuse it without { stride: 4 } instead of reading x, y, z,
+        // intensity as x, y, z.
+        let stride = Object::new();
+        set(&stride, "value", 4.0);
+        let _ = Object::define_property(&points, &"stride".into(), &stride);
         ScanView {
             index,
-            points: Float32Array::from(&scan.points[..]),
+            points,
             stride: Exactly,
             pose: Float64Array::from(&scan.pose.to_cols_array()[..]),
             labels: Uint32Array::from(&scan.labels[..]),

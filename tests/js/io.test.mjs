@@ -96,6 +96,28 @@ test("every format gives the polygons of the raw local .bin, to 1 mm", async () 
   assert.equal(files[6][1].length % 16, 0);
 });
 
+test("points made with 4 values a point (a KITTI .bin, a simulated scan) are refused without { stride: 4 }, not read as x, y, z", async () => {
+  const raw = await io.readKittiBin(LOCAL_BIN, { name: "local.bin" });
+  const sim = psSim.simulate({ layout: "street", seed: 1 }).scan(0);
+  for (const points of [raw.points, sim.points]) {
+    const mark = Object.getOwnPropertyDescriptor(points, "stride");
+    assert.equal(mark.value, 4);
+    assert.equal(mark.enumerable, false, "not among the array's keys");
+    const refused = (call) =>
+      assert.throws(call, (e) => e instanceof Error && /option 'stride': not given/.test(e.message) && /pass \{ stride: 4 \}/.test(e.message));
+    refused(() => ps.detect(points));
+    refused(() => ps.detectFlat(points, { viewpoint: [0, 0, 0] }));
+    const scenario = new ps.Scenario();
+    refused(() => scenario.addScan(points, { pose: sim.pose }));
+    assert.equal(scenario.scans, 0, "a refused scan is not counted");
+    // Given, the stride is read as given.
+    assert.ok(scenario.addScan(points, { stride: 4, pose: sim.pose }).polygonCount > 0);
+    scenario.free();
+  }
+  // Points of stride 3 carry no mark (LAS, PCD, PLY give x, y, z).
+  assert.equal(Object.getOwnPropertyDescriptor(new Float32Array(raw.points), "stride"), undefined);
+});
+
 test("LAS: the CRS of its GeoTIFF keys or WKT record comes back, ready for polyscene/geo", async () => {
   const keys = await io.readPoints(fx.las(POINTS.slice(0, 100), fx.UTM, { crs: { epsg: 32632 } }));
   assert.equal(keys.crs.epsg, 32632);
