@@ -90,8 +90,13 @@ impl fmt::Display for Error {
             Error::BadLength { len, stride } => write!(
                 f,
                 "point buffer length {len} is not a multiple of the stride {stride} \
-                 (expected interleaved x, y, z{} values)",
-                if *stride == 4 { ", intensity" } else { "" }
+                 (expected interleaved x, y, z{} values){}",
+                if *stride == 4 { ", intensity" } else { "" },
+                if *stride == 3 && len % 4 == 0 {
+                    "; for x, y, z, intensity (a KITTI .bin) give stride 4"
+                } else {
+                    ""
+                }
             ),
             Error::BadStride(s) => write!(
                 f,

@@ -503,7 +503,8 @@ pub(crate) fn points_of(v: &JsValue, stride: Option<Stride>) -> WasmResult<(Coor
         Ok(values) => Ok((values, stride)),
         Err(NumbersError::Failed(f)) => Err(f),
         Err(NumbersError::NotNumber(i, x)) => Err(invalid(format!(
-            "points: element {i} is not a number (got {})",
+            "points: element {i} is not a number (got {}); points are one flat list \
+             of interleaved x, y, z[, intensity] values",
             describe(&x)
         ))
         .into()),

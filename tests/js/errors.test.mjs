@@ -20,7 +20,10 @@ function stillWorks() {
 test("point buffers: length, stride, NaN and Infinity, type", () => {
   const s = new ps.Scenario();
   throwsError(assert, () => s.addScan(new Float32Array(7), { stride: 4 }), /length 7/, /multiple of the stride 4/);
-  throwsError(assert, () => ps.detect(new Float32Array(4)), /length 4/, /stride 3/);
+  throwsError(assert, () => ps.detect(new Float32Array(4)), /length 4/, /stride 3/, /x, y, z, intensity .* give stride 4/);
+  // The hint only where four values a point would fit.
+  assert.throws(() => ps.detect(new Float32Array(5)), (e) => /length 5/.test(e.message) && !/give stride 4/.test(e.message));
+  throwsError(assert, () => ps.detect([[0, 0, 0], [1, 1, 1], [2, 0, 1]]), /element 0 is not a number \(got an Array\)/, /one flat list/);
   throwsError(assert, () => ps.detect(new Float32Array(6), { stride: 5 }), /'stride'/, /3 .* or 4/);
   throwsError(assert, () => s.addScan(new Float32Array(6), { stride: "3" }), /'stride'/);
   throwsError(assert, () => s.addScan(Float32Array.from([0, 0, 0, 1, NaN, 2])), /point 1/, /NaN or infinite/);
