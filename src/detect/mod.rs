@@ -231,7 +231,12 @@ fn detect_all(
             let mean = cloud.points.iter().map(|p| p.as_dvec3()).sum::<DVec3>() / n;
             let above = cloud.origin + mean + DVec3::new(0.0, 0.0, 1e4);
             let policy = CascadePolicy::one_shot().without_viewpoint();
-            (policy.seen_from_all(!sensors.is_empty()), above)
+            let policy = if sensors.is_empty() {
+                policy
+            } else {
+                policy.seen_from_all()
+            };
+            (policy, above)
         }
     };
     let det = Detector {

@@ -225,13 +225,13 @@ impl CascadePolicy {
         }
     }
 
-    /// For a cloud gathered from sensor positions that are `known`
+    /// For a cloud gathered from known sensor positions
     /// ([`detect_from`](super::detect_from)): candidates seen edge-on from
     /// every one of them are rejected as laser rings; the other rules stay
     /// as they are.
-    pub const fn seen_from_all(self, known: bool) -> Self {
+    pub const fn seen_from_all(self) -> Self {
         CascadePolicy {
-            reject_edge_on_candidates: self.reject_edge_on_candidates || known,
+            reject_edge_on_candidates: true,
             ..self
         }
     }
