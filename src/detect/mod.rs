@@ -145,6 +145,20 @@ pub fn detect_from(cloud: &Cloud, params: &Params, viewpoints: &[DVec3]) -> Resu
     Ok(found.unwrap_or_default())
 }
 
+/// Is `len` numbers a flat list of x, y, z of each sensor position for
+/// [`detect_from`] (the JS `viewpoints` option, the CLI's `--viewpoints`)?
+/// Else [`Error::BadOption`] `viewpoints`.
+pub(crate) fn check_flat_positions(len: usize) -> Result<()> {
+    if len % 3 == 0 {
+        Ok(())
+    } else {
+        Err(Error::BadOption {
+            key: "viewpoints".into(),
+            reason: format!("must be a flat list of x, y, z of each position, got {len} values"),
+        })
+    }
+}
+
 /// [`detect_from`] that calls `progress` after each round of the cascade (the
 /// rounds' count is not known in advance: `points_left` falls towards 0);
 /// [`ControlFlow::Break`] stops it there and gives `Ok(None)`. The result of

@@ -557,16 +557,7 @@ pub(crate) fn detect_input(
 /// `viewpoints`: x, y, z of each position in one flat list of numbers.
 fn positions_of(v: &JsValue) -> WasmResult<Positions> {
     const WHAT: &str = "option 'viewpoints'";
-    let whole = |len: usize| {
-        if len % 3 == 0 {
-            Ok(())
-        } else {
-            Err(bad_option(
-                "viewpoints",
-                format!("must be a flat list of x, y, z of each position, got {len} values"),
-            ))
-        }
-    };
+    let whole = crate::detect::check_flat_positions;
     let nums = match numbers_of::<f64>(v, WHAT, 3 * MAX_VIEWPOINTS, &whole) {
         Ok(nums) => nums,
         Err(NumbersError::Failed(f)) => return Err(f),

@@ -428,15 +428,7 @@ fn read_lidar_poses(path: &str, calib: Option<&str>) -> Result<Vec<glam::DMat4>>
 }
 
 fn detect_cmd(args: DetectArgs, params: Params) -> Result<String> {
-    if args.viewpoints.len() % 3 != 0 {
-        return Err(Error::BadOption {
-            key: "viewpoints".into(),
-            reason: format!(
-                "must be a flat list of x, y, z of each position, got {} values",
-                args.viewpoints.len()
-            ),
-        });
-    }
+    crate::detect::check_flat_positions(args.viewpoints.len())?;
     let mut viewpoints: Vec<glam::DVec3> = args
         .viewpoints
         .chunks_exact(3)
