@@ -910,11 +910,6 @@ fn flat_ground(rng: &mut Rng) -> Vec<DVec3> {
     pts
 }
 
-/// A sensor cannot see a surface it lies in: a plane through the viewpoint,
-/// away from it, is the laser rings at the sensor's own height (over a
-/// location they close into a few m^2 of false surface). Such a candidate
-/// is dropped; the same patch a little higher, and a floor under a sensor
-/// standing on it, are kept.
 /// Flat ground and a 3 m x 3 m horizontal patch at height `z` above it,
 /// 6-9 m from the origin.
 fn patch_over_ground(z: f64, rng: &mut Rng) -> Vec<DVec3> {
@@ -943,29 +938,30 @@ fn flat_at(det: &polyscene::detect::Detection, z: f64) -> usize {
         .count()
 }
 
+/// A sensor cannot see a surface it lies in: a plane through the viewpoint,
+/// away from it, is the laser rings at the sensor's own height (over a
+/// location they close into a few m^2 of false surface). Such a candidate
+/// is dropped; the same patch a little higher, and a floor under a sensor
+/// standing on it, are kept.
 #[test]
 fn planes_through_the_viewpoint_away_from_it_are_not_surfaces() {
     let mut rng = Rng::new(21);
-    let ground = |rng: &mut Rng, pts: &mut Vec<DVec3>| pts.extend(flat_ground(rng));
-    let patch_at = patch_over_ground;
     let p = Params {
         viewpoint: Some([0.0, 0.0, 1.8]),
         ..Params::gpp2()
     };
     // At sensor height: only the ground.
-    let c = cloud(&patch_at(1.8, &mut rng));
+    let c = cloud(&patch_over_ground(1.8, &mut rng));
     let det = detect(&c, &p).unwrap();
     check_invariants(&c, &det, &p);
     assert_eq!(flat_at(&det, 0.0), 1);
     assert_eq!(flat_at(&det, 1.8), 0);
     // Half a metre higher it is seen from below: kept.
-    let c = cloud(&patch_at(2.3, &mut rng));
+    let c = cloud(&patch_over_ground(2.3, &mut rng));
     let det = detect(&c, &p).unwrap();
     assert_eq!((flat_at(&det, 0.0), flat_at(&det, 2.3)), (1, 1));
     // A sensor standing on the floor sees the floor.
-    let mut pts = Vec::new();
-    ground(&mut rng, &mut pts);
-    let c = cloud(&pts);
+    let c = cloud(&flat_ground(&mut rng));
     let on_floor = Params {
         viewpoint: Some([2.0, 3.0, 0.0]),
         ..Params::gpp2()
