@@ -15,7 +15,7 @@ pub(crate) mod points;
 pub(crate) mod stats;
 
 use crate::geometry::bounds;
-use crate::geometry::polygon::{contains, distance, rings_within};
+use crate::geometry::polygon::{distance, rings_within};
 use crate::params::Params;
 use crate::primitive::Primitive;
 use glam::{DVec2, DVec3};
@@ -87,16 +87,41 @@ pub fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
         return false;
     }
     if layered {
-        let inside = small_v
-            .iter()
-            .map(|&v| big.frame.to_local(v))
-            .filter(|&q| contains(&big.outline, q) || distance(&big.outline, q) <= params.merge_gap)
-            .count();
-        return 4 * inside >= 3 * small_v.len() && (seen_twice || seen_on_both(small, big));
+        return most_within(small_v, big, params.merge_gap)
+            && (seen_twice || seen_on_both(small, big));
     }
     // The outlines, both in a's frame: touching or overlapping?
     let b_in_a: Vec<DVec2> = bv.iter().map(|&v| a.frame.to_local(v)).collect();
     rings_within(&a.outline, &b_in_a, params.merge_gap)
+}
+
+/// Do at least three quarters of `vertices` (world) lie within `gap` of
+/// `big`'s outline region (inside it, or within `gap` of its boundary)?
+/// Each test reads every edge of `big`'s outline (a road's has hundreds),
+/// so a vertex beyond the outline's box by more than `gap` is passed over,
+/// and the count stops once the answer is known.
+fn most_within(vertices: &[DVec3], big: &Primitive, gap: f64) -> bool {
+    let pad = DVec2::splat(gap * (1.0 + 1e-9) + 1e-12);
+    let (lo, hi) = big
+        .outline
+        .iter()
+        .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        });
+    let (lo, hi) = (lo - pad, hi + pad);
+    let need = (3 * vertices.len()).div_ceil(4);
+    let (mut inside, mut left) = (0, vertices.len());
+    for &v in vertices {
+        if inside >= need || inside + left < need {
+            break;
+        }
+        left -= 1;
+        let q = big.frame.to_local(v);
+        if q.cmpge(lo).all() && q.cmple(hi).all() && distance(&big.outline, q) <= gap {
+            inside += 1;
+        }
+    }
+    inside >= need
 }
 
 /// Are two outlines' bounding boxes (world, from their vertices) farther
