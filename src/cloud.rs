@@ -183,8 +183,8 @@ fn largest_coordinate(values: &[f32], stride: usize) -> Result<f32> {
 
 /// [`largest_coordinate`] of points of `S` values (`S` of 3 or 4), `None`
 /// when one is not finite. Four points a step, lane by lane, so that the
-/// loop vectorises (2.7x faster on a 120,000-point scan): `v - v == 0` is
-/// false for NaN and the infinities alone. Native only: the wasm build has
+/// loop vectorises (0.27 -> 0.14 ms on a 120,000-point scan): `|v| < inf`
+/// is false for NaN and the infinities alone. Native only: the wasm build has
 /// the vectoriser off.
 #[cfg(not(target_arch = "wasm32"))]
 fn largest_of<const S: usize>(values: &[f32]) -> Option<f32> {
@@ -196,14 +196,14 @@ fn largest_of<const S: usize>(values: &[f32]) -> Option<f32> {
         for j in 0..4 * S {
             let a = q[j].abs();
             big[j] = if a > big[j] { a } else { big[j] };
-            fine[j] &= q[j] - q[j] == 0.0;
+            fine[j] &= a < f32::INFINITY;
         }
     }
     for p in quads.remainder().chunks_exact(S) {
         for j in 0..3 {
             let a = p[j].abs();
             big[j] = if a > big[j] { a } else { big[j] };
-            fine[j] &= p[j] - p[j] == 0.0;
+            fine[j] &= a < f32::INFINITY;
         }
     }
     let xyz = (0..4 * S).filter(|j| j % S < 3);
