@@ -31,9 +31,9 @@ pub(crate) struct Surfaces<'a> {
     cells: GridMap<[i64; 3], (u32, u32)>,
     items: Vec<usize>,
     wide: Vec<usize>,
-    /// Per position in `prims`, the box it is filed by, with a margin for
-    /// rounding (everything for polygons not filed, or with a vertex not
-    /// finite).
+    /// Per position in `prims`, the box it is filed by, grown by the slack
+    /// once more for rounding (everything for polygons not filed, or with
+    /// a vertex not finite).
     boxes: Vec<(DVec3, DVec3)>,
     /// The last cell looked up and its range: consecutive points of a scan
     /// mostly share a cell, and the hash lookup was most of a query.
@@ -55,11 +55,9 @@ impl<'a> Surfaces<'a> {
             let (lo, hi) = bounds(&prim.vertices());
             let pad = DVec3::splat(slack(prim));
             if lo.is_finite() && hi.is_finite() {
-                // With a margin far above the rounding of the frames at
-                // these coordinates.
-                let far = lo.abs().max(hi.abs()).max_element();
-                let margin = pad * (1.0 + 1e-9) + DVec3::splat(1e-9 * (1.0 + far));
-                boxes[k] = (lo - margin, hi + margin);
+                // Grown by twice the slack: a margin far above the
+                // rounding of the frames.
+                boxes[k] = (lo - 2.0 * pad, hi + 2.0 * pad);
             }
             let (a, b) = (cell_of(lo - pad), cell_of(hi + pad));
             let count = (0..3).fold(1i64, |c, i| {
@@ -134,8 +132,8 @@ impl Surfaces<'_> {
         self.near(w).any(|k| {
             let prim = &self.prims[k];
             // Such a point lies in the box the polygon is filed by (its
-            // vertices' box grown by the slack, and a margin); the cell it
-            // is filed under is far larger.
+            // vertices' box grown by the slack, here twice); the cell it is
+            // filed under is far larger.
             let (lo, hi) = self.boxes[k];
             w.cmpge(lo).all()
                 && w.cmple(hi).all()
