@@ -31,10 +31,6 @@ pub(crate) struct Surfaces<'a> {
     cells: GridMap<[i64; 3], (u32, u32)>,
     items: Vec<usize>,
     wide: Vec<usize>,
-    /// Per position in `prims`, the box it is filed by, grown by the slack
-    /// once more for rounding (everything for polygons not filed, or with
-    /// a vertex not finite).
-    boxes: Vec<(DVec3, DVec3)>,
     /// The last cell looked up and its range: consecutive points of a scan
     /// mostly share a cell, and the hash lookup was most of a query.
     last: Cell<Option<CellRange>>,
@@ -45,7 +41,6 @@ impl<'a> Surfaces<'a> {
     /// `slack(prim)` (m) around its outline's box.
     pub fn new(prims: &'a [Primitive], ids: &[u32], slack: impl Fn(&Primitive) -> f64) -> Self {
         let mut wide = Vec::new();
-        let mut boxes = vec![(DVec3::NEG_INFINITY, DVec3::INFINITY); prims.len()];
         let mut lists: GridMap<[i64; 3], Vec<usize>> = GridMap::default();
         for &id in ids {
             let Ok(k) = prims.binary_search_by_key(&id, |q| q.id) else {
@@ -54,11 +49,6 @@ impl<'a> Surfaces<'a> {
             let prim = &prims[k];
             let (lo, hi) = bounds(&prim.vertices());
             let pad = DVec3::splat(slack(prim));
-            if lo.is_finite() && hi.is_finite() {
-                // Grown by twice the slack: a margin far above the
-                // rounding of the frames.
-                boxes[k] = (lo - 2.0 * pad, hi + 2.0 * pad);
-            }
             let (a, b) = (cell_of(lo - pad), cell_of(hi + pad));
             let count = (0..3).fold(1i64, |c, i| {
                 c.saturating_mul(b[i].saturating_sub(a[i]).saturating_add(1))
@@ -89,7 +79,6 @@ impl<'a> Surfaces<'a> {
             cells,
             items,
             wide,
-            boxes,
             last: Cell::new(None),
         }
     }
@@ -131,13 +120,7 @@ impl Surfaces<'_> {
     pub fn holds(&self, w: DVec3, params: &Params) -> bool {
         self.near(w).any(|k| {
             let prim = &self.prims[k];
-            // Such a point lies in the box the polygon is filed by (its
-            // vertices' box grown by the slack, here twice); the cell it is
-            // filed under is far larger.
-            let (lo, hi) = self.boxes[k];
-            w.cmpge(lo).all()
-                && w.cmple(hi).all()
-                && prim.plane.signed_distance(w).abs() <= seen_slack(prim, params)
+            prim.plane.signed_distance(w).abs() <= seen_slack(prim, params)
                 && crate::geometry::polygon::contains(&prim.outline, prim.frame.to_local(w))
         })
     }
