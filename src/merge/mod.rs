@@ -101,13 +101,16 @@ pub fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
 /// so a vertex beyond the outline's box by more than `gap` is passed over,
 /// and the count stops once the answer is known.
 fn most_within(vertices: &[DVec3], big: &Primitive, gap: f64) -> bool {
-    let pad = DVec2::splat(gap * (1.0 + 1e-9) + 1e-12);
     let (lo, hi) = big
         .outline
         .iter()
         .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), &v| {
             (lo.min(v), hi.max(v))
         });
+    // The margin also covers the rounding of the distance's closest point
+    // (an ulp or so of the outline's largest coordinate).
+    let far = lo.abs().max(hi.abs()).max_element();
+    let pad = DVec2::splat(gap * (1.0 + 1e-9) + 1e-9 * (1.0 + far));
     let (lo, hi) = (lo - pad, hi + pad);
     let need = (3 * vertices.len()).div_ceil(4);
     let (mut inside, mut left) = (0, vertices.len());
