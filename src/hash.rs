@@ -1,6 +1,7 @@
 //! A small deterministic hasher for integer grid keys (the std default is
 //! randomly seeded and slower). Maps built with it are only ever looked up,
-//! never iterated to produce results, so output does not depend on it.
+//! never iterated to produce results, so output does not depend on it (a
+//! derived `Debug` of a struct holding one prints the map's order).
 
 use crate::geometry::floor_i64;
 use std::collections::HashMap;

@@ -52,8 +52,9 @@ pub(crate) struct Scratch {
 /// their outline, in id order, for the next scan: most outlines stay the
 /// same from one scan to the next (85 % of expansions on the simulated
 /// street), and building their masks again took 0.85 ms of a scan's
-/// 9.7 ms of expansion there (BENCHMARKS.md). Derived state, bounded by the primitives in one scan's reach: it never
-/// makes two scenarios unequal, and a restored scenario starts without it.
+/// 9.7 ms of expansion there (BENCHMARKS.md). Derived state, bounded by
+/// the primitives in one scan's reach: it never makes two scenarios
+/// unequal, and a restored scenario starts without it.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Masks(Vec<KeptMask>);
 
