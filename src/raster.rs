@@ -78,38 +78,50 @@ impl Closing {
 /// The outer boundary of the cells not `outside` (a hole-free 4-connected
 /// region) along cell edges, counter-clockwise, in grid-corner coordinates.
 fn trace_ring(outside: &[bool], w: usize, h: usize) -> Option<Vec<(i64, i64)>> {
-    let inside = |x: i64, y: i64| -> bool {
-        x >= 0
-            && y >= 0
-            && (x as usize) < w
-            && (y as usize) < h
-            && !outside[y as usize * w + x as usize]
-    };
     // Directed boundary edges with the region on the left; from each corner
     // exactly one leaves (no pinches), keyed by its start corner.
     let mut next_of: Vec<u32> = vec![u32::MAX; (w + 1) * (h + 1)];
-    let cid = |x: i64, y: i64| y as usize * (w + 1) + x as usize;
+    let cid = |x: usize, y: usize| y * (w + 1) + x;
     let mut first = None;
-    for y in 0..h as i64 {
-        for x in 0..w as i64 {
-            if !inside(x, y) {
+    // Beyond the grid is outside.
+    let all_out = vec![true; w];
+    for y in 0..h {
+        let row = &outside[y * w..(y + 1) * w];
+        let below = if y > 0 {
+            &outside[(y - 1) * w..y * w]
+        } else {
+            &all_out[..]
+        };
+        let above = if y + 1 < h {
+            &outside[(y + 1) * w..(y + 2) * w]
+        } else {
+            &all_out[..]
+        };
+        for x in 0..w {
+            // Only the region's cells with a side on the outside give edges.
+            if row[x] {
+                continue;
+            }
+            let left = x == 0 || row[x - 1];
+            let right = x + 1 == w || row[x + 1];
+            if !(below[x] || above[x] || left || right) {
                 continue;
             }
             // bottom edge (region above): left to right
-            if !inside(x, y - 1) {
+            if below[x] {
                 next_of[cid(x, y)] = cid(x + 1, y) as u32;
                 first.get_or_insert(cid(x, y));
             }
             // right edge: bottom to top
-            if !inside(x + 1, y) {
+            if right {
                 next_of[cid(x + 1, y)] = cid(x + 1, y + 1) as u32;
             }
             // top edge: right to left
-            if !inside(x, y + 1) {
+            if above[x] {
                 next_of[cid(x + 1, y + 1)] = cid(x, y + 1) as u32;
             }
             // left edge: top to bottom
-            if !inside(x - 1, y) {
+            if left {
                 next_of[cid(x, y + 1)] = cid(x, y) as u32;
             }
         }
