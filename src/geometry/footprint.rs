@@ -24,7 +24,7 @@
 //! (occupancy, merging and expansion read it), so it stays here.
 
 use super::polygon::{
-    is_simple, make_ccw, remove_collinear, signed_area, simplify_raised, simplify_within,
+    is_simple, make_ccw, remove_collinear, signed_area, simplify_within, DouglasPeucker,
 };
 use crate::raster::{BitGrid, Closing};
 use glam::DVec2;
@@ -579,8 +579,9 @@ impl Footprint {
             };
             // First with every hole filled; the cuts only if that fits.
             let (ring, inside) = trace(&[])?;
-            let (mut out, inside) = match simplify_within(&ring, tolerance, max_vertices) {
-                None => (simplify_raised(&ring, tolerance, max_vertices), inside),
+            let mut splits = DouglasPeucker::new(&ring, tolerance);
+            let (mut out, inside) = match splits.within(tolerance, max_vertices) {
+                None => (splits.raised(tolerance, max_vertices), inside),
                 Some(filled) => {
                     let cuts = closing.cuts(min_hole);
                     let cut = if cuts.is_empty() { None } else { trace(&cuts) };

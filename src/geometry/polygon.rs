@@ -241,103 +241,180 @@ pub fn remove_collinear(ring: &mut Vec<DVec2>) {
 /// `tolerance` has few enough vertices but self-intersects, smaller
 /// tolerances are tried first. Last resort: the ring's convex hull.
 pub fn simplify(ring: &[DVec2], tolerance: f64, max_vertices: usize) -> Vec<DVec2> {
-    simplify_within(ring, tolerance, max_vertices)
-        .unwrap_or_else(|| simplify_raised(ring, tolerance, max_vertices))
+    let mut splits = DouglasPeucker::new(ring, tolerance);
+    splits
+        .within(tolerance, max_vertices)
+        .unwrap_or_else(|| splits.raised(tolerance, max_vertices))
 }
 
 /// The rest of [`simplify`] once [`simplify_within`] found no ring: the
 /// tolerance raised until one fits, or the convex hull.
 pub fn simplify_raised(ring: &[DVec2], tolerance: f64, max_vertices: usize) -> Vec<DVec2> {
-    let max_vertices = max_vertices.max(4);
-    let tol = tolerance.max(0.0);
-    let mut t = if tol > 0.0 { tol } else { 1e-3 };
-    for _ in 0..80 {
-        t *= 1.5;
-        let out = dp_closed(ring, t);
-        if out.len() <= max_vertices && is_simple(&out) {
-            return out;
-        }
-        if out.len() < 3 {
-            break;
-        }
-    }
-    match super::hull::convex_hull(ring) {
-        Some(h) if h.len() <= max_vertices => h,
-        // Any subset of a convex polygon's vertices is convex and simple.
-        Some(h) => (0..max_vertices)
-            .map(|k| h[k * h.len() / max_vertices])
-            .collect(),
-        None => ring.to_vec(),
-    }
+    DouglasPeucker::new(ring, tolerance).raised(tolerance, max_vertices)
 }
 
 /// [`simplify`] without raising the tolerance: `None` when the ring needs
 /// a larger tolerance than `tolerance` to fit in `max_vertices` simply.
 pub fn simplify_within(ring: &[DVec2], tolerance: f64, max_vertices: usize) -> Option<Vec<DVec2>> {
-    let n = ring.len();
-    let max_vertices = max_vertices.max(4);
-    if n <= 4 || (n <= max_vertices && tolerance <= 0.0) {
-        return Some(ring.to_vec());
-    }
-    let tol = tolerance.max(0.0);
-    let first = dp_closed(ring, tol);
-    if first.len() <= max_vertices && is_simple(&first) {
-        return Some(first);
-    }
-    if first.len() <= max_vertices {
-        let mut t = tol * 0.5;
-        for _ in 0..20 {
-            let out = dp_closed(ring, t);
-            if out.len() > max_vertices {
-                break;
-            }
-            if is_simple(&out) {
-                return Some(out);
-            }
-            t *= 0.5;
-        }
-    }
-    None
+    DouglasPeucker::new(ring, tolerance).within(tolerance, max_vertices)
 }
 
-fn dp_closed(ring: &[DVec2], tol: f64) -> Vec<DVec2> {
-    let n = ring.len();
-    // Split at the two mutually farthest-ish vertices: vertex 0 and the one
-    // farthest from it.
-    let far = (1..n)
-        .max_by(|&i, &j| {
-            (ring[i] - ring[0])
-                .length_squared()
-                .total_cmp(&(ring[j] - ring[0]).length_squared())
-        })
-        .unwrap_or(n / 2);
-    let mut keep = vec![false; n];
-    keep[0] = true;
-    keep[far] = true;
-    let tol2 = tol * tol;
-    let mut stack = vec![(0usize, far), (far, n)];
-    while let Some((s, e)) = stack.pop() {
-        if e <= s + 1 {
-            continue;
-        }
-        let (a, b) = (ring[s], ring[e % n]);
-        let mut best = (0.0, 0usize);
-        for (i, &p) in ring.iter().enumerate().take(e).skip(s + 1) {
-            let d = segment_distance_sq(p, a, b);
-            if d > best.0 {
-                best = (d, i);
-            }
-        }
-        if best.0 > tol2 {
-            keep[best.1] = true;
-            stack.push((s, best.1));
-            stack.push((best.1, e));
+/// Douglas–Peucker simplification of a closed ring at many tolerances from
+/// one pass. The ring is split at vertex 0 and the vertex farthest from
+/// it, then each piece at its vertex farthest from the chord, until the
+/// pieces lie within the smallest tolerance asked for: which vertex splits
+/// which piece does not depend on the tolerance, only how deep the
+/// splitting goes. So a vertex is kept at tolerance `t` when its own
+/// distance and those of all the splits above it exceed `t`: the smallest
+/// of them, kept per vertex, is compared with `t`, and the answer is the
+/// same vertices as a Douglas–Peucker run at `t`. [`simplify`] tries
+/// tolerance after tolerance on rings of thousands of vertices (a road's
+/// or a plaza's outline, traced from its footprint); each try costs one
+/// pass over the vertices.
+pub(crate) struct DouglasPeucker<'a> {
+    ring: &'a [DVec2],
+    /// The smallest tolerance the splits are wanted for (m).
+    floor: f64,
+    /// The vertex farthest from vertex 0: both are always kept.
+    far: usize,
+    /// Per vertex, the smallest squared chord distance on its path of
+    /// splits (0 for a vertex never split at); empty until the first
+    /// [`DouglasPeucker::at`].
+    keep_above: Vec<f64>,
+}
+
+impl<'a> DouglasPeucker<'a> {
+    /// The splits of `ring` for tolerances from `floor` (m) up; made at the
+    /// first [`DouglasPeucker::at`], and again for a smaller tolerance.
+    pub(crate) fn new(ring: &'a [DVec2], floor: f64) -> Self {
+        DouglasPeucker {
+            ring,
+            floor: floor.max(0.0),
+            far: 0,
+            keep_above: Vec::new(),
         }
     }
-    ring.iter()
-        .zip(keep)
-        .filter_map(|(&p, k)| k.then_some(p))
-        .collect()
+
+    /// Split down to pieces within `self.floor` of their chords: such a
+    /// piece keeps none of its inner vertices at any tolerance from the
+    /// floor up.
+    fn split(&mut self) {
+        let (ring, n) = (self.ring, self.ring.len());
+        let floor2 = self.floor * self.floor;
+        let mut keep_above = vec![0.0; n];
+        // Split at the two mutually farthest-ish vertices: vertex 0 and the
+        // one farthest from it.
+        let far = (1..n)
+            .max_by(|&i, &j| {
+                (ring[i] - ring[0])
+                    .length_squared()
+                    .total_cmp(&(ring[j] - ring[0]).length_squared())
+            })
+            .unwrap_or(n / 2);
+        // Pieces as (first, end, the smallest split distance above them).
+        let mut stack = vec![(0usize, far, f64::INFINITY), (far, n, f64::INFINITY)];
+        while let Some((s, e, above)) = stack.pop() {
+            if e <= s + 1 {
+                continue;
+            }
+            let (a, b) = (ring[s], ring[e % n]);
+            let mut best = (0.0, 0usize);
+            for (i, &p) in ring.iter().enumerate().take(e).skip(s + 1) {
+                let d = segment_distance_sq(p, a, b);
+                if d > best.0 {
+                    best = (d, i);
+                }
+            }
+            if best.0 > floor2 {
+                let k = best.0.min(above);
+                keep_above[best.1] = k;
+                stack.push((s, best.1, k));
+                stack.push((best.1, e, k));
+            }
+        }
+        self.far = far;
+        self.keep_above = keep_above;
+    }
+
+    /// The ring simplified within `tol` (m): vertex 0, the vertex farthest
+    /// from it, and the vertices whose splits all lie farther than `tol`
+    /// from their chords. The same vertices as Douglas–Peucker run at
+    /// `tol`.
+    pub(crate) fn at(&mut self, tol: f64) -> Vec<DVec2> {
+        if self.ring.is_empty() {
+            return Vec::new();
+        }
+        if tol < self.floor {
+            self.floor = 0.0;
+            self.keep_above.clear();
+        }
+        if self.keep_above.is_empty() {
+            self.split();
+        }
+        let tol2 = tol * tol;
+        let far = self.far;
+        self.ring
+            .iter()
+            .zip(&self.keep_above)
+            .enumerate()
+            .filter_map(|(i, (&p, &k))| (k > tol2 || i == 0 || i == far).then_some(p))
+            .collect()
+    }
+
+    /// See [`simplify_within`].
+    pub(crate) fn within(&mut self, tolerance: f64, max_vertices: usize) -> Option<Vec<DVec2>> {
+        let ring = self.ring;
+        let n = ring.len();
+        let max_vertices = max_vertices.max(4);
+        if n <= 4 || (n <= max_vertices && tolerance <= 0.0) {
+            return Some(ring.to_vec());
+        }
+        let tol = tolerance.max(0.0);
+        let first = self.at(tol);
+        if first.len() <= max_vertices && is_simple(&first) {
+            return Some(first);
+        }
+        if first.len() <= max_vertices {
+            let mut t = tol * 0.5;
+            for _ in 0..20 {
+                let out = self.at(t);
+                if out.len() > max_vertices {
+                    break;
+                }
+                if is_simple(&out) {
+                    return Some(out);
+                }
+                t *= 0.5;
+            }
+        }
+        None
+    }
+
+    /// See [`simplify_raised`].
+    pub(crate) fn raised(&mut self, tolerance: f64, max_vertices: usize) -> Vec<DVec2> {
+        let ring = self.ring;
+        let max_vertices = max_vertices.max(4);
+        let tol = tolerance.max(0.0);
+        let mut t = if tol > 0.0 { tol } else { 1e-3 };
+        for _ in 0..80 {
+            t *= 1.5;
+            let out = self.at(t);
+            if out.len() <= max_vertices && is_simple(&out) {
+                return out;
+            }
+            if out.len() < 3 {
+                break;
+            }
+        }
+        match super::hull::convex_hull(ring) {
+            Some(h) if h.len() <= max_vertices => h,
+            // Any subset of a convex polygon's vertices is convex and simple.
+            Some(h) => (0..max_vertices)
+                .map(|k| h[k * h.len() / max_vertices])
+                .collect(),
+            None => ring.to_vec(),
+        }
+    }
 }
 
 /// Smallest distance between the boundaries of two rings, or 0 when they
@@ -469,6 +546,90 @@ impl Polygon3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Douglas–Peucker run at one tolerance: the reference the splits made
+    /// once must agree with.
+    fn dp_reference(ring: &[DVec2], tol: f64) -> Vec<DVec2> {
+        let n = ring.len();
+        let far = (1..n)
+            .max_by(|&i, &j| {
+                (ring[i] - ring[0])
+                    .length_squared()
+                    .total_cmp(&(ring[j] - ring[0]).length_squared())
+            })
+            .unwrap_or(n / 2);
+        let mut keep = vec![false; n];
+        keep[0] = true;
+        keep[far] = true;
+        let tol2 = tol * tol;
+        let mut stack = vec![(0usize, far), (far, n)];
+        while let Some((s, e)) = stack.pop() {
+            if e <= s + 1 {
+                continue;
+            }
+            let (a, b) = (ring[s], ring[e % n]);
+            let mut best = (0.0, 0usize);
+            for (i, &p) in ring.iter().enumerate().take(e).skip(s + 1) {
+                let d = segment_distance_sq(p, a, b);
+                if d > best.0 {
+                    best = (d, i);
+                }
+            }
+            if best.0 > tol2 {
+                keep[best.1] = true;
+                stack.push((s, best.1));
+                stack.push((best.1, e));
+            }
+        }
+        ring.iter()
+            .zip(keep)
+            .filter_map(|(&p, k)| k.then_some(p))
+            .collect()
+    }
+
+    #[test]
+    fn splits_made_once_keep_what_douglas_peucker_keeps_at_each_tolerance() {
+        let mut rng = crate::rng::Rng::new(3);
+        for case in 0..200 {
+            // Staircases on a 0.2 m grid (as traced footprints are), wobbly
+            // stars, and rings with repeated and collinear vertices.
+            let n = 5 + rng.below(400);
+            let ring: Vec<DVec2> = (0..n)
+                .map(|k| {
+                    let a = k as f64 / n as f64 * std::f64::consts::TAU;
+                    let r = 5.0 + 3.0 * rng.uniform();
+                    let p = DVec2::new(r * a.cos(), r * a.sin());
+                    match case % 3 {
+                        0 => (p / 0.2).floor() * 0.2,
+                        1 => p,
+                        _ => DVec2::new((p.x * 2.0).round() * 0.5, p.y),
+                    }
+                })
+                .collect();
+            // The floor first, then tolerances above and below it (below
+            // makes the splits again, deeper).
+            let floor = 0.05 + 0.3 * rng.uniform();
+            let mut splits = DouglasPeucker::new(&ring, floor);
+            for tol in [
+                floor,
+                floor * 1.5,
+                2.0,
+                0.0,
+                floor * 0.25,
+                1e-9,
+                f64::INFINITY,
+            ] {
+                assert_eq!(
+                    splits.at(tol),
+                    dp_reference(&ring, tol),
+                    "case {case}, tol {tol}"
+                );
+            }
+        }
+        assert!(DouglasPeucker::new(&[], 0.1).at(0.1).is_empty());
+        let one = [DVec2::ONE];
+        assert_eq!(DouglasPeucker::new(&one, 0.1).at(0.1), one.to_vec());
+    }
 
     /// Every pair of edges: the reference the bucketed test must agree with.
     fn is_simple_brute_force(ring: &[DVec2]) -> bool {
