@@ -78,51 +78,74 @@ impl Closing {
 /// The outer boundary of the cells not `outside` (a hole-free 4-connected
 /// region) along cell edges, counter-clockwise, in grid-corner coordinates.
 fn trace_ring(outside: &[bool], w: usize, h: usize) -> Option<Vec<(i64, i64)>> {
+    // The region's cells as bits, each row padded to whole words (padding
+    // clear: beyond the grid is outside).
+    let stride = w.div_ceil(64);
+    let mut inside = vec![0u64; stride * h];
+    for y in 0..h {
+        pack_inside(
+            &outside[y * w..(y + 1) * w],
+            &mut inside[y * stride..(y + 1) * stride],
+        );
+    }
     // Directed boundary edges with the region on the left; from each corner
-    // exactly one leaves (no pinches), keyed by its start corner.
-    let mut next_of: Vec<u32> = vec![u32::MAX; (w + 1) * (h + 1)];
+    // exactly one leaves (no pinches), kept at its start corner as the way
+    // it leaves (one byte; 0: none): right, up, left or down. A cell's
+    // edges are set in the order bottom, right, top, left, cells in
+    // row-major order.
+    const RIGHT: u8 = 1;
+    const UP: u8 = 2;
+    const LEFT: u8 = 3;
+    const DOWN: u8 = 4;
+    let mut way: Vec<u8> = vec![0; (w + 1) * (h + 1)];
     let cid = |x: usize, y: usize| y * (w + 1) + x;
     let mut first = None;
-    // Beyond the grid is outside.
-    let all_out = vec![true; w];
+    let none = vec![0u64; stride];
     for y in 0..h {
-        let row = &outside[y * w..(y + 1) * w];
+        let row = &inside[y * stride..(y + 1) * stride];
         let below = if y > 0 {
-            &outside[(y - 1) * w..y * w]
+            &inside[(y - 1) * stride..y * stride]
         } else {
-            &all_out[..]
+            &none[..]
         };
         let above = if y + 1 < h {
-            &outside[(y + 1) * w..(y + 2) * w]
+            &inside[(y + 1) * stride..(y + 2) * stride]
         } else {
-            &all_out[..]
+            &none[..]
         };
-        for x in 0..w {
-            // Only the region's cells with a side on the outside give edges.
-            if row[x] {
+        for (i, &cells) in row.iter().enumerate() {
+            if cells == 0 {
                 continue;
             }
-            let left = x == 0 || row[x - 1];
-            let right = x + 1 == w || row[x + 1];
-            if !(below[x] || above[x] || left || right) {
-                continue;
-            }
-            // bottom edge (region above): left to right
-            if below[x] {
-                next_of[cid(x, y)] = cid(x + 1, y) as u32;
-                first.get_or_insert(cid(x, y));
-            }
-            // right edge: bottom to top
-            if right {
-                next_of[cid(x + 1, y)] = cid(x + 1, y + 1) as u32;
-            }
-            // top edge: right to left
-            if above[x] {
-                next_of[cid(x + 1, y + 1)] = cid(x, y + 1) as u32;
-            }
-            // left edge: top to bottom
-            if left {
-                next_of[cid(x, y + 1)] = cid(x, y) as u32;
+            // Bit b: is the cell left (right) of cell b inside?
+            let left_in = cells << 1 | if i > 0 { row[i - 1] >> 63 } else { 0 };
+            let right_in = cells >> 1 | if i + 1 < stride { row[i + 1] << 63 } else { 0 };
+            let bottom = cells & !below[i];
+            let right = cells & !right_in;
+            let top = cells & !above[i];
+            let left = cells & !left_in;
+            let mut edged = bottom | right | top | left;
+            while edged != 0 {
+                let b = edged.trailing_zeros() as usize;
+                edged &= edged - 1;
+                let (x, bit) = (i * 64 + b, 1u64 << b);
+                // bottom edge (region above): left to right
+                if bottom & bit != 0 {
+                    way[cid(x, y)] = RIGHT;
+                    first.get_or_insert(cid(x, y));
+                }
+                // right edge: bottom to top
+                if right & bit != 0 {
+                    way[cid(x + 1, y)] = UP;
+                }
+                // top edge: right to left
+                if top & bit != 0 {
+                    way[cid(x + 1, y + 1)] = LEFT;
+                }
+                // left edge: top to bottom
+                if left & bit != 0 {
+                    way[cid(x, y + 1)] = DOWN;
+                }
             }
         }
     }
@@ -132,16 +155,42 @@ fn trace_ring(outside: &[bool], w: usize, h: usize) -> Option<Vec<(i64, i64)>> {
     let limit = 4 * w * h + 4;
     loop {
         ring.push(((c % (w + 1)) as i64, (c / (w + 1)) as i64));
-        let n = next_of[c];
-        if n == u32::MAX || ring.len() > limit {
+        c = match way[c] {
+            RIGHT => c + 1,
+            UP => c + (w + 1),
+            LEFT => c - 1,
+            DOWN => c - (w + 1),
+            _ => return None,
+        };
+        if ring.len() > limit {
             return None;
         }
-        c = n as usize;
         if c == start {
             break;
         }
     }
     Some(ring)
+}
+
+/// The cells of `row` that are not outside, as bits (cell `x` is bit
+/// `x % 64` of word `x / 64`), into `dst`. Eight cells at a time: a bool
+/// is one byte, 0 or 1, and multiplying eight such bytes by
+/// `0x0102_0408_1020_4080` gathers byte `k` into bit `56 + k`.
+fn pack_inside(row: &[bool], dst: &mut [u64]) {
+    for (word, cells) in dst.iter_mut().zip(row.chunks(64)) {
+        let mut v = 0u64;
+        let mut groups = cells.chunks_exact(8);
+        for (g, eight) in groups.by_ref().enumerate() {
+            let bytes = u64::from_le_bytes(std::array::from_fn(|k| u8::from(eight[k])));
+            let out = bytes.wrapping_mul(0x0102_0408_1020_4080) >> 56;
+            v |= (!out & 0xff) << (8 * g);
+        }
+        let done = cells.len() - groups.remainder().len();
+        for (k, &o) in groups.remainder().iter().enumerate() {
+            v |= u64::from(!o) << (done + k);
+        }
+        *word = v;
+    }
 }
 
 /// The cuts of [`Closing::cuts`]: for each hole of the region `!outside`
@@ -621,6 +670,99 @@ pub(crate) fn dilate_disk(grid: &[bool], w: usize, h: usize, radius: f64) -> Vec
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Cell by cell: the reference the word-wise trace must agree with.
+    fn trace_ring_by_cells(outside: &[bool], w: usize, h: usize) -> Option<Vec<(i64, i64)>> {
+        let inside = |x: i64, y: i64| -> bool {
+            x >= 0
+                && y >= 0
+                && (x as usize) < w
+                && (y as usize) < h
+                && !outside[y as usize * w + x as usize]
+        };
+        let mut next_of: Vec<u32> = vec![u32::MAX; (w + 1) * (h + 1)];
+        let cid = |x: i64, y: i64| y as usize * (w + 1) + x as usize;
+        let mut first = None;
+        for y in 0..h as i64 {
+            for x in 0..w as i64 {
+                if !inside(x, y) {
+                    continue;
+                }
+                if !inside(x, y - 1) {
+                    next_of[cid(x, y)] = cid(x + 1, y) as u32;
+                    first.get_or_insert(cid(x, y));
+                }
+                if !inside(x + 1, y) {
+                    next_of[cid(x + 1, y)] = cid(x + 1, y + 1) as u32;
+                }
+                if !inside(x, y + 1) {
+                    next_of[cid(x + 1, y + 1)] = cid(x, y + 1) as u32;
+                }
+                if !inside(x - 1, y) {
+                    next_of[cid(x, y + 1)] = cid(x, y) as u32;
+                }
+            }
+        }
+        let start = first?;
+        let mut ring = Vec::new();
+        let mut c = start;
+        loop {
+            ring.push(((c % (w + 1)) as i64, (c / (w + 1)) as i64));
+            let n = next_of[c];
+            if n == u32::MAX || ring.len() > 4 * w * h + 4 {
+                return None;
+            }
+            c = n as usize;
+            if c == start {
+                return Some(ring);
+            }
+        }
+    }
+
+    #[test]
+    fn tracing_word_by_word_gives_the_ring_cell_by_cell_gives() {
+        // Every byte pattern packs to its bits, at every offset of a row.
+        for w in [1usize, 7, 8, 9, 63, 64, 65, 130] {
+            for pattern in 0..256u32 {
+                let row: Vec<bool> = (0..w).map(|x| pattern >> (x % 8) & 1 == 0).collect();
+                let mut words = vec![0u64; w.div_ceil(64)];
+                pack_inside(&row, &mut words);
+                for (x, &o) in row.iter().enumerate() {
+                    assert_eq!(words[x / 64] >> (x % 64) & 1 == 1, !o, "w {w}, x {x}");
+                }
+                assert_eq!(words.last().map_or(0, |v| v.count_ones()) as usize, {
+                    let tail = w - 64 * (w.div_ceil(64) - 1);
+                    row[w - tail..].iter().filter(|&&o| !o).count()
+                });
+            }
+        }
+        // Blobs, with pinches and cells on the grid's border, as the
+        // largest region's exterior and as raw random cells.
+        let mut rng = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            rng
+        };
+        for case in 0..300 {
+            let (w, h) = (1 + (next() % 150) as usize, 1 + (next() % 40) as usize);
+            let fill = next() % 100;
+            let cells: Vec<bool> = (0..w * h).map(|_| next() % 100 < fill).collect();
+            let grid = BitGrid::from_bools(&cells, w, h);
+            let raw: Vec<bool> = cells.iter().map(|&c| !c).collect();
+            for outside in [exterior_of_largest_region(&grid).map(|(o, _)| o), Some(raw)]
+                .into_iter()
+                .flatten()
+            {
+                assert_eq!(
+                    trace_ring(&outside, w, h),
+                    trace_ring_by_cells(&outside, w, h),
+                    "case {case}, {w} x {h}"
+                );
+            }
+        }
+    }
 
     /// Exact squared Euclidean distance (in cells) from every cell to the nearest
     /// set cell (Felzenszwalb–Huttenlocher, separable, linear time).
