@@ -721,6 +721,10 @@ mod tests {
 
     #[test]
     fn tracing_word_by_word_gives_the_ring_cell_by_cell_gives() {
+        // No cells, no ring.
+        for (w, h) in [(0, 0), (0, 3), (3, 0)] {
+            assert_eq!(trace_ring(&[], w, h), None);
+        }
         // Every byte pattern packs to its bits, at every offset of a row.
         for w in [1usize, 7, 8, 9, 63, 64, 65, 130] {
             for pattern in 0..256u32 {
@@ -746,7 +750,12 @@ mod tests {
             rng
         };
         for case in 0..300 {
-            let (w, h) = (1 + (next() % 150) as usize, 1 + (next() % 40) as usize);
+            // Every fourth grid a whole number of words wide.
+            let w = match case % 4 {
+                0 => 64 * (1 + (next() % 3) as usize),
+                _ => 1 + (next() % 150) as usize,
+            };
+            let h = 1 + (next() % 40) as usize;
             let fill = next() % 100;
             let cells: Vec<bool> = (0..w * h).map(|_| next() % 100 < fill).collect();
             let grid = BitGrid::from_bools(&cells, w, h);

@@ -261,16 +261,16 @@ pub fn simplify_within(ring: &[DVec2], tolerance: f64, max_vertices: usize) -> O
 
 /// Douglas–Peucker simplification of a closed ring at many tolerances from
 /// one pass. The ring is split at vertex 0 and the vertex farthest from
-/// it, then each piece at its vertex farthest from the chord, until the
-/// pieces lie within the smallest tolerance asked for: which vertex splits
-/// which piece does not depend on the tolerance, only how deep the
+/// it, then each piece at its vertex farthest from the chord, down to the
+/// floor given to `new` (a smaller tolerance, which `within` rarely tries,
+/// splits it again down to every vertex off its chord): which vertex
+/// splits which piece does not depend on the tolerance, only how deep the
 /// splitting goes. So a vertex is kept at tolerance `t` when its own
 /// distance and those of all the splits above it exceed `t`: the smallest
 /// of them, kept per vertex, is compared with `t`, and the answer is the
 /// same vertices as a Douglas–Peucker run at `t`. [`simplify`] tries
 /// tolerance after tolerance on rings of thousands of vertices (a road's
-/// or a plaza's outline, traced from its footprint); each try costs one
-/// pass over the vertices.
+/// or a plaza's traced outline), each try one pass over the vertices.
 pub(crate) struct DouglasPeucker<'a> {
     ring: &'a [DVec2],
     /// The smallest tolerance the splits are wanted for (m).
