@@ -547,40 +547,38 @@ impl Polygon3 {
 mod tests {
     use super::*;
 
-    /// Douglas–Peucker run at one tolerance: the reference the splits made
-    /// once must agree with.
+    /// Douglas–Peucker run at one tolerance, recursively: the reference the
+    /// splits made once must agree with (the same start, the last of
+    /// equally far vertices from vertex 0, and the first farthest vertex
+    /// of each piece).
     fn dp_reference(ring: &[DVec2], tol: f64) -> Vec<DVec2> {
-        let n = ring.len();
-        let far = (1..n)
-            .max_by(|&i, &j| {
-                (ring[i] - ring[0])
-                    .length_squared()
-                    .total_cmp(&(ring[j] - ring[0]).length_squared())
-            })
-            .unwrap_or(n / 2);
-        let mut keep = vec![false; n];
-        keep[0] = true;
-        keep[far] = true;
-        let tol2 = tol * tol;
-        let mut stack = vec![(0usize, far), (far, n)];
-        while let Some((s, e)) = stack.pop() {
-            if e <= s + 1 {
-                continue;
-            }
-            let (a, b) = (ring[s], ring[e % n]);
-            let mut best = (0.0, 0usize);
-            for (i, &p) in ring.iter().enumerate().take(e).skip(s + 1) {
-                let d = segment_distance_sq(p, a, b);
-                if d > best.0 {
-                    best = (d, i);
-                }
-            }
-            if best.0 > tol2 {
-                keep[best.1] = true;
-                stack.push((s, best.1));
-                stack.push((best.1, e));
+        fn keep_in(ring: &[DVec2], s: usize, e: usize, tol2: f64, keep: &mut [bool]) {
+            let (a, b) = (ring[s], ring[e % ring.len()]);
+            let split = (s + 1..e)
+                .map(|i| (segment_distance_sq(ring[i], a, b), i))
+                .fold(
+                    (0.0, 0),
+                    |best, (d, i)| if d > best.0 { (d, i) } else { best },
+                );
+            if split.0 > tol2 {
+                keep[split.1] = true;
+                keep_in(ring, s, split.1, tol2, keep);
+                keep_in(ring, split.1, e, tol2, keep);
             }
         }
+        let mut far = ring.len() / 2;
+        let mut far_d = f64::NEG_INFINITY;
+        for (i, p) in ring.iter().enumerate().skip(1) {
+            let d = (*p - ring[0]).length_squared();
+            if d.total_cmp(&far_d).is_ge() {
+                (far, far_d) = (i, d);
+            }
+        }
+        let mut keep = vec![false; ring.len()];
+        keep[0] = true;
+        keep[far] = true;
+        keep_in(ring, 0, far, tol * tol, &mut keep);
+        keep_in(ring, far, ring.len(), tol * tol, &mut keep);
         ring.iter()
             .zip(keep)
             .filter_map(|(&p, k)| k.then_some(p))
