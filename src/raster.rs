@@ -78,16 +78,10 @@ impl Closing {
 /// The outer boundary of the cells not `outside` (a hole-free 4-connected
 /// region) along cell edges, counter-clockwise, in grid-corner coordinates.
 fn trace_ring(outside: &[bool], w: usize, h: usize) -> Option<Vec<(i64, i64)>> {
-    // The region's cells as bits, each row padded to whole words (padding
-    // clear: beyond the grid is outside).
-    let stride = w.div_ceil(64);
-    let mut inside = vec![0u64; stride * h];
-    for y in 0..h {
-        pack_inside(
-            &outside[y * w..(y + 1) * w],
-            &mut inside[y * stride..(y + 1) * stride],
-        );
-    }
+    // The region's cells as bits (a row's padding is clear: beyond the
+    // grid is outside).
+    let region = BitGrid::where_cells_are(outside, false, w, h);
+    let stride = region.stride;
     // Directed boundary edges with the region on the left; from each corner
     // exactly one leaves (no pinches), kept at its start corner as the way
     // it leaves (one byte; 0: none): right, up, left or down. A cell's
@@ -102,14 +96,10 @@ fn trace_ring(outside: &[bool], w: usize, h: usize) -> Option<Vec<(i64, i64)>> {
     let mut first = None;
     let none = vec![0u64; stride];
     for y in 0..h {
-        let row = &inside[y * stride..(y + 1) * stride];
-        let below = if y > 0 {
-            &inside[(y - 1) * stride..y * stride]
-        } else {
-            &none[..]
-        };
+        let row = region.row(y);
+        let below = if y > 0 { region.row(y - 1) } else { &none[..] };
         let above = if y + 1 < h {
-            &inside[(y + 1) * stride..(y + 2) * stride]
+            region.row(y + 1)
         } else {
             &none[..]
         };
@@ -172,22 +162,23 @@ fn trace_ring(outside: &[bool], w: usize, h: usize) -> Option<Vec<(i64, i64)>> {
     Some(ring)
 }
 
-/// The cells of `row` that are not outside, as bits (cell `x` is bit
-/// `x % 64` of word `x / 64`), into `dst`. Eight cells at a time: a bool
-/// is one byte, 0 or 1, and multiplying eight such bytes by
+/// The cells of `row` equal to `value`, as bits (cell `x` is bit `x % 64`
+/// of word `x / 64`), into `dst`. Eight cells at a time: a bool is one
+/// byte, 0 or 1, and multiplying eight such bytes by
 /// `0x0102_0408_1020_4080` gathers byte `k` into bit `56 + k`.
-fn pack_inside(row: &[bool], dst: &mut [u64]) {
+fn pack_row(row: &[bool], value: bool, dst: &mut [u64]) {
+    let flip = if value { 0 } else { 0xff };
     for (word, cells) in dst.iter_mut().zip(row.chunks(64)) {
         let mut v = 0u64;
         let mut groups = cells.chunks_exact(8);
         for (g, eight) in groups.by_ref().enumerate() {
             let bytes = u64::from_le_bytes(std::array::from_fn(|k| u8::from(eight[k])));
-            let out = bytes.wrapping_mul(0x0102_0408_1020_4080) >> 56;
-            v |= (!out & 0xff) << (8 * g);
+            let got = bytes.wrapping_mul(0x0102_0408_1020_4080) >> 56;
+            v |= ((got ^ flip) & 0xff) << (8 * g);
         }
         let done = cells.len() - groups.remainder().len();
-        for (k, &o) in groups.remainder().iter().enumerate() {
-            v |= u64::from(!o) << (done + k);
+        for (k, &c) in groups.remainder().iter().enumerate() {
+            v |= u64::from(c == value) << (done + k);
         }
         *word = v;
     }
@@ -412,14 +403,22 @@ impl BitGrid {
 
     /// From one bool per cell, row-major.
     pub(crate) fn from_bools(cells: &[bool], w: usize, h: usize) -> Self {
+        BitGrid::where_cells_are(cells, true, w, h)
+    }
+
+    /// The cells of `cells` (one bool per cell, row-major) equal to `value`.
+    fn where_cells_are(cells: &[bool], value: bool, w: usize, h: usize) -> Self {
         let mut g = BitGrid::new(w, h);
         if w == 0 {
             return g;
         }
-        for (y, row) in cells.chunks(w).take(h).enumerate() {
-            for (x, _) in row.iter().enumerate().filter(|(_, &c)| c) {
-                g.set(x, y);
-            }
+        let stride = g.stride;
+        for (row, words) in cells
+            .chunks(w)
+            .take(h)
+            .zip(g.words.chunks_exact_mut(stride))
+        {
+            pack_row(row, value, words);
         }
         g
     }
@@ -730,9 +729,13 @@ mod tests {
             for pattern in 0..256u32 {
                 let row: Vec<bool> = (0..w).map(|x| pattern >> (x % 8) & 1 == 0).collect();
                 let mut words = vec![0u64; w.div_ceil(64)];
-                pack_inside(&row, &mut words);
+                pack_row(&row, false, &mut words);
                 for (x, &o) in row.iter().enumerate() {
                     assert_eq!(words[x / 64] >> (x % 64) & 1 == 1, !o, "w {w}, x {x}");
+                }
+                let grid = BitGrid::from_bools(&row, w, 1);
+                for (x, &o) in row.iter().enumerate() {
+                    assert_eq!(grid.get(x, 0), o, "w {w}, x {x}");
                 }
                 assert_eq!(words.last().map_or(0, |v| v.count_ones()) as usize, {
                     let tail = w - 64 * (w.div_ceil(64) - 1);
