@@ -142,8 +142,11 @@ impl GroundRule<'_> {
     }
 
     /// Is `plane` ground, judged where it passes over `at` (a hypothesis,
-    /// drawn near `at`)? `viewpoint` and `at` in the plane's coordinates,
-    /// which are the floor's.
+    /// drawn near `at`) on a floor, and under the viewpoint itself below
+    /// one? The flag picks a hypothesis's inlier distance and clustering
+    /// tolerance; judged under `at` there too, the bench's crossing drives
+    /// lost a plateau (BENCHMARKS.md). `viewpoint` and `at` in the plane's
+    /// coordinates, which are the floor's.
     pub(crate) fn at_point(
         &self,
         plane: &Plane,
@@ -160,16 +163,22 @@ impl GroundRule<'_> {
     }
 
     /// Is `plane` (world coordinates) ground, judged on its support `pts`
-    /// (local coordinates, the floor's): most of them on the floor?
+    /// (local coordinates, the floor's): most of them on the floor? Below
+    /// the viewpoint, the depth is taken where the support lies (`centre`,
+    /// world), under the viewpoint's height: a plane fitted a few degrees
+    /// off level (a car's roof from a few laser rings) passes metres below
+    /// a sensor 20 m away.
     pub(crate) fn of_support(
         &self,
         plane: &Plane,
         viewpoint: DVec3,
+        centre: DVec3,
         pts: &[Vec3],
         min_cos: f64,
         depth: f64,
     ) -> bool {
-        self.is_ground(plane, viewpoint, (min_cos, depth), |grid| {
+        let above = DVec3::new(centre.x, centre.y, viewpoint.z);
+        self.is_ground(plane, above, (min_cos, depth), |grid| {
             2 * pts.iter().filter(|p| grid.on_floor(p.as_dvec3())).count() >= pts.len()
         })
     }

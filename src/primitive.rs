@@ -502,9 +502,16 @@ pub(crate) fn shape(
         inner,
     } = robust_fit(&world, world.first()?.round())?;
     let plane = fit.oriented(viewpoint);
-    // Ground: near-horizontal, well below the sensor (then, oriented
-    // towards the sensor, facing up).
-    let ground = ground.of_support(&plane, viewpoint, pts, libm::cos(tilt), params.ground_depth);
+    // Ground: near-horizontal, well below the sensor's height where the
+    // support lies (then, oriented towards the sensor, facing up).
+    let ground = ground.of_support(
+        &plane,
+        viewpoint,
+        moments.mean(),
+        pts,
+        libm::cos(tilt),
+        params.ground_depth,
+    );
     let frame = Frame::on_plane(&plane, moments.mean());
     let surface = params.surface(ground);
     // Support is what lies within the inlier distance of the final plane.
@@ -708,6 +715,51 @@ mod tests {
         assert!(judge(&tilted(30.0), below), "a slant");
         assert!(!judge(&tilted(10.0), below), "an awning");
         assert!(!judge(&tilted(88.0), below), "upright");
+    }
+
+    /// Below a viewpoint, ground is judged where a surface lies: a car's
+    /// roof 0.3 m under a sensor 20 m away, fitted 5 degrees off level
+    /// (its plane passes 1.75 m lower under the sensor), is no ground; the
+    /// road, tilted the same way, is. Ground primitives grow 2 m a scan
+    /// (`groundExpandAlong`): a roof taken for ground reached the next
+    /// parked car's roof in the bench's street drives.
+    #[test]
+    fn a_roof_fitted_off_level_far_from_the_sensor_is_no_ground() {
+        let p = Params::gpp2();
+        let sensor = DVec3::new(0.0, 0.0, 1.8);
+        // A 2 m x 1.6 m patch centred 20 m from the sensor at height z0,
+        // rising away from the sensor by `deg`.
+        let patch = |z0: f64, deg: f64| -> Vec<Vec3> {
+            let slope = deg.to_radians().tan();
+            let mut pts = Vec::new();
+            for i in 0..=40 {
+                for j in 0..=32 {
+                    let (x, y) = (19.0 + 0.05 * i as f64, -0.8 + 0.05 * j as f64);
+                    let z = z0 + (x - 20.0) * slope;
+                    pts.push(Vec3::new(x as f32, y as f32, z as f32));
+                }
+            }
+            pts
+        };
+        let ground = |pts: &[Vec3]| {
+            shape(
+                DVec3::ZERO,
+                pts,
+                &p,
+                sensor,
+                GroundRule::BelowViewpoint,
+                ShapeRules::default(),
+            )
+            .expect("a primitive")
+            .primitive
+            .ground
+        };
+        assert!(!ground(&patch(1.5, 5.0)), "a roof off level");
+        assert!(!ground(&patch(1.5, 0.0)), "a level roof");
+        assert!(ground(&patch(0.0, 5.0)), "a road off level");
+        assert!(ground(&patch(0.0, 0.0)), "a level road");
+        // Beyond `groundMaxTilt` nothing is ground.
+        assert!(!ground(&patch(0.0, 20.0)), "a slope");
     }
 
     #[test]

@@ -16,10 +16,10 @@ options! {
     /// Default 15.
     ground_max_tilt: f64 = ground_max_tilt, "deg", Check::Between(0.0, 90.0);
     /// In the scenario, ground lies at least this far below the scan's
-    /// sensor (m); a horizontal plane higher up (a car's roof, a table) is
-    /// an ordinary primitive. One-shot detection decides ground from the
-    /// cloud's local floor instead. Default 1.3 (sensors on a car roof sit
-    /// 1.7-2 m up).
+    /// sensor (m), measured where it lies; a horizontal plane higher up (a
+    /// car's roof, a table) is an ordinary primitive, even fitted a few
+    /// degrees off level. One-shot detection decides ground from the local
+    /// floor instead. Default 1.3 (sensors on a car roof sit 1.7-2 m up).
     ground_depth: f64 = ground_depth, "m", Check::NonNegative;
     /// Sensor position for one-shot detection (world, m): normals of
     /// non-horizontal planes point towards it, the ground's clustering
