@@ -141,12 +141,12 @@ impl GroundRule<'_> {
         }
     }
 
-    /// Is `plane` ground, judged where it passes over `at` (a hypothesis,
-    /// drawn near `at`) on a floor, and under the viewpoint itself below
-    /// one? The flag picks a hypothesis's inlier distance and clustering
-    /// tolerance; judged under `at` there too, the bench's crossing drives
-    /// lost a plateau (BENCHMARKS.md). `viewpoint` and `at` in the plane's
-    /// coordinates, which are the floor's.
+    /// Is `plane` ground? On a floor, judged where it passes over `at` (a
+    /// hypothesis, drawn near `at`); below the viewpoint, under the
+    /// viewpoint itself. The flag picks a hypothesis's inlier distance and
+    /// clustering tolerance; judged under `at` below a viewpoint too, the
+    /// bench's crossing drives lost a plateau (BENCHMARKS.md). `viewpoint`
+    /// and `at` in the plane's coordinates, which are the floor's.
     pub(crate) fn at_point(
         &self,
         plane: &Plane,
