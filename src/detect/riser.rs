@@ -25,18 +25,18 @@
 //! 3. Each segment's face is the line its evidence lies along, within the
 //!    non-ground inlier distance (a robust fit: wheels and poles next to a
 //!    curb fall away). Faces on one line that overlap or lie within
-//!    `2 * alpha` merge, across pairs of surfaces (a curb runs past several
-//!    pieces of road).
+//!    `2 * alpha` (grown as below) merge, across pairs of surfaces (a curb
+//!    runs past several pieces of road, and a far one's outline is jagged).
 //! 4. A face is cut where its points leave a gap wider than `2 * alpha`;
 //!    a piece is kept when its points cover at least `minOccupancy` of its
 //!    length (each point the `cell` after it) and its area (length times
 //!    step) is at least `minArea`. Its outline is the rectangle between the
 //!    two surfaces; its points are labelled with it. When the points come
-//!    from one sensor whose position is known ([`Spacing`]), both lengths
-//!    grow with the square of the range beyond `groundClusterRange`: a
-//!    laser ring hits a curb's face only where it crosses the curb's line,
-//!    so the runs of points on a face lie as far apart as the rings do on
-//!    the ground.
+//!    from one sensor whose position is known ([`Spacing`]), the gaps of
+//!    steps 3 and 4 and each point's length grow with the square of the
+//!    range beyond `groundClusterRange`: a laser ring hits a curb's face
+//!    only where it crosses the curb's line, so the runs of points on a
+//!    face lie as far apart as the rings do on the ground.
 
 use crate::geometry::plane::Moments;
 use crate::geometry::polygon::{make_ccw, segment_distance_sq, signed_area};
@@ -400,7 +400,7 @@ pub(crate) fn find_risers(
         .iter()
         .filter_map(|s| fit_face(s, &surfaces, pts, origin, tol))
         .collect();
-    merge_faces(&mut faces, pts, origin, tol, 2.0 * p.other.alpha);
+    merge_faces(&mut faces, pts, origin, tol, 2.0 * p.other.alpha, spacing);
     let mut out = Vec::new();
     for face in &faces {
         for piece in split(face, pts, origin, 2.0 * p.other.alpha, spacing) {
@@ -743,8 +743,15 @@ fn line_fit(plan: Plan, idx: &[u32], hint: DVec2) -> Option<(DVec2, DVec2)> {
 /// Step 3, across segments: faces on one line (within 5 degrees and `tol`)
 /// between the same heights (each surface within `tol` of the other's at
 /// the joined face's centre) whose extents overlap or lie within `gap`
-/// become one.
-fn merge_faces(faces: &mut Vec<Face>, pts: &[Vec3], origin: DVec3, tol: f64, gap: f64) {
+/// (times the `spacing` at the gap's middle, as in [`split`]) become one.
+fn merge_faces(
+    faces: &mut Vec<Face>,
+    pts: &[Vec3],
+    origin: DVec3,
+    tol: f64,
+    gap: f64,
+    spacing: Spacing,
+) {
     let cos_parallel = libm::cos(PARALLEL_DEG.to_radians());
     let plan = Plan { pts, origin };
     // Groups of faces joined pairwise (union-find, smallest index as root),
@@ -759,7 +766,7 @@ fn merge_faces(faces: &mut Vec<Face>, pts: &[Vec3], origin: DVec3, tol: f64, gap
     }
     for i in 0..faces.len() {
         for j in i + 1..faces.len() {
-            if on_one_line(&faces[i], &faces[j], tol, gap, cos_parallel) {
+            if on_one_line(&faces[i], &faces[j], tol, gap, spacing, cos_parallel) {
                 let (a, b) = (find(&mut root, i), find(&mut root, j));
                 root[a.max(b)] = a.min(b);
             }
@@ -798,8 +805,16 @@ fn merge_faces(faces: &mut Vec<Face>, pts: &[Vec3], origin: DVec3, tol: f64, gap
 
 /// Whether two faces lie on one line (within 5 degrees and `tol`) between
 /// the same heights (each surface within `tol` of the other's at their
-/// middle), with extents that overlap or lie within `gap`.
-fn on_one_line(f: &Face, g: &Face, tol: f64, gap: f64, cos_parallel: f64) -> bool {
+/// middle), with extents that overlap or lie within `gap` times the
+/// `spacing` at the gap's middle.
+fn on_one_line(
+    f: &Face,
+    g: &Face,
+    tol: f64,
+    gap: f64,
+    spacing: Spacing,
+    cos_parallel: f64,
+) -> bool {
     if f.dir.dot(g.dir).abs() < cos_parallel
         || f.dir.perp().dot(g.at - f.at).abs() > tol
         || g.dir.perp().dot(f.at - g.at).abs() > tol
@@ -812,10 +827,13 @@ fn on_one_line(f: &Face, g: &Face, tol: f64, gap: f64, cos_parallel: f64) -> boo
     {
         return false;
     }
-    // g's extent along f's line.
+    // g's extent along f's line, and the gap between the two extents
+    // (negative where they overlap), allowed as wide as the evidence may
+    // leave at its middle (`Spacing`).
     let ends = [g.at + g.dir * g.lo, g.at + g.dir * g.hi].map(|q| f.dir.dot(q - f.at));
     let (g0, g1) = (ends[0].min(ends[1]), ends[0].max(ends[1]));
-    g0 <= f.hi + gap && f.lo <= g1 + gap
+    let (a, b) = if g0 > f.hi { (f.hi, g0) } else { (g1, f.lo) };
+    b - a <= gap * spacing.scale(f.at + f.dir * (0.5 * (a + b)))
 }
 
 /// The height of a near-horizontal plane over the plan point `q`.
@@ -1107,6 +1125,49 @@ mod tests {
             ..CascadePolicy::one_shot()
         };
         assert_eq!(run(alike).primitives.len(), 2);
+    }
+
+    #[test]
+    fn far_faces_on_one_line_join_across_the_gaps_the_rings_leave() {
+        // A curb's face 20-40 m along y = 0 from a foot at x = -10: runs of
+        // points 1 m long every 2.5 m (gaps of 1.5 m, over `2 * alpha`),
+        // each the face of one segment of a jagged outline.
+        use super::{merge_faces, Face, Plan, Spacing};
+        use crate::geometry::Plane;
+        use glam::{DVec2, Vec3};
+        let mut pts = Vec::new();
+        let mut runs = Vec::new();
+        for k in 0..8 {
+            let first = pts.len() as u32;
+            for i in 0..11 {
+                let x = 20.0 + 2.5 * k as f32 + 0.1 * i as f32;
+                pts.push(Vec3::new(x, 0.0, 0.05 + 0.01 * (i % 5) as f32));
+            }
+            runs.push((first..pts.len() as u32).collect::<Vec<u32>>());
+        }
+        let plan = Plan {
+            pts: &pts,
+            origin: DVec3::ZERO,
+        };
+        let lower = Plane::from_point_normal(DVec3::ZERO, DVec3::Z);
+        let upper = Plane::from_point_normal(DVec3::new(0.0, 1.0, 0.15), DVec3::Z);
+        let faces = || -> Vec<Face> {
+            runs.iter()
+                .map(|r| Face::new(lower, upper, plan.at(r[0]), DVec2::X, r.clone(), plan, 0.08))
+                .collect()
+        };
+        let joined = |foot: Option<DVec2>| {
+            let mut f = faces();
+            let spacing = Spacing { foot, range: 20.0 };
+            merge_faces(&mut f, &pts, DVec3::ZERO, 0.08, 1.0, spacing);
+            f.iter().map(|f| f.points.len()).collect::<Vec<_>>()
+        };
+        // Seen from the foot, 30-50 m away: one face of every point.
+        assert_eq!(joined(Some(DVec2::new(-10.0, 0.0))), vec![88]);
+        // From a foot among them, the near gaps are too wide.
+        assert_eq!(joined(Some(DVec2::new(25.0, 0.0))).len(), 8);
+        // Seen from nowhere known, the gaps are too wide everywhere.
+        assert_eq!(joined(None).len(), 8);
     }
 
     #[test]
