@@ -790,3 +790,65 @@ fn replay_refuses_what_it_cannot_align() {
     let e = run(&args(&["replay", &flat_s])).unwrap_err().to_string();
     assert!(e.contains("poses.txt") && e.contains("3 poses"), "{e}");
 }
+
+/// `detect` and `replay` write each polygon with the fields of the JS
+/// API's polygon objects: the floor is ground and the wall is not, the
+/// density is the support over the area, and a drive's polygons carry the
+/// scans that found them and last grew them.
+#[test]
+fn polygons_carry_ground_density_and_scans() {
+    let dir = TempDir::new("fields");
+    let cloud = write_cloud(&dir);
+    let out = run(&args(&["detect", &cloud, "--stride", "4"])).unwrap();
+    let doc: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let all = doc["polygons"].as_array().unwrap();
+    let up = |p: &serde_json::Value| p["normal"][2].as_f64().unwrap().abs() > 0.99;
+    let floor = all.iter().find(|p| up(p)).expect("the floor");
+    let wall = all.iter().find(|p| !up(p)).expect("the wall");
+    assert_eq!(floor["ground"].as_bool(), Some(true), "{out}");
+    assert_eq!(wall["ground"].as_bool(), Some(false), "{out}");
+    for p in all {
+        let (support, area) = (p["support"].as_f64().unwrap(), p["area"].as_f64().unwrap());
+        assert!((p["density"].as_f64().unwrap() - support / area).abs() < 1e-9);
+        assert_eq!(
+            (p["bornScan"].as_u64(), p["lastScan"].as_u64()),
+            (Some(0), Some(0))
+        );
+    }
+
+    let flat = path_of(&dir, "drive");
+    run(&args(&[
+        "simulate", "street", "--seed", "2", "--scans", "6", "--out", &flat,
+    ]))
+    .unwrap();
+    let out = run(&args(&["replay", &flat])).unwrap();
+    let doc: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let all = doc["polygons"].as_array().unwrap();
+    let area = |p: &serde_json::Value| p["area"].as_f64().unwrap();
+    let road = all
+        .iter()
+        .filter(|p| up(p))
+        .max_by(|a, b| area(a).total_cmp(&area(b)))
+        .unwrap();
+    assert_eq!(road["ground"].as_bool(), Some(true), "{road}");
+    assert!(all.iter().any(|p| !up(p)));
+    assert!(all.iter().filter(|p| !up(p)).all(|p| p["ground"] == false));
+    let scans: Vec<(u64, u64)> = all
+        .iter()
+        .map(|p| {
+            (
+                p["bornScan"].as_u64().unwrap(),
+                p["lastScan"].as_u64().unwrap(),
+            )
+        })
+        .collect();
+    assert!(scans.iter().all(|&(b, l)| b <= l && l <= 5), "{scans:?}");
+    assert!(
+        scans.iter().any(|&(_, l)| l == 5),
+        "the last scan grew one: {scans:?}"
+    );
+    assert!(
+        scans.iter().any(|&(b, _)| b > 0),
+        "a later scan found one: {scans:?}"
+    );
+}

@@ -348,11 +348,22 @@ pub struct PolygonJson {
     pub vertices: Vec<[f64; 3]>,
     /// Area (m^2).
     pub area: f64,
-    /// Support points.
+    /// Support points (over all scans).
     pub support: u64,
+    /// Support points per m^2 of outline.
+    pub density: f64,
+    /// Ground (road, sidewalk, plaza): by the local floor in one-shot
+    /// detection, `groundDepth` under the sensor in the scenario.
+    pub ground: bool,
+    /// Scan in which it was detected (0 for one-shot detection).
+    pub born_scan: u64,
+    /// Last scan in which it gained support (0 for one-shot detection).
+    pub last_scan: u64,
 }
 
 impl From<&Primitive> for PolygonJson {
+    /// The fields of the JS API's polygon objects (`PolygonView` in the
+    /// binding), with the outline as an array of points.
     fn from(p: &Primitive) -> Self {
         PolygonJson {
             id: p.id,
@@ -361,6 +372,10 @@ impl From<&Primitive> for PolygonJson {
             vertices: p.vertices().iter().map(|v| v.to_array()).collect(),
             area: p.area,
             support: p.support,
+            density: p.density(),
+            ground: p.ground,
+            born_scan: p.born_scan,
+            last_scan: p.last_scan,
         }
     }
 }
