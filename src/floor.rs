@@ -119,7 +119,7 @@ pub(crate) fn sensor_could_stand_at(pts: &[Vec3], p: DVec3) -> bool {
 /// distance, clustering tolerance and outline radius).
 #[derive(Clone, Copy)]
 pub(crate) enum GroundRule<'g> {
-    /// Near-horizontal and at least `groundDepth` below the viewpoint.
+    /// Near-horizontal and `groundDepth` below the viewpoint's height.
     BelowViewpoint,
     /// Near-horizontal and on the cloud's local floor.
     LocalFloor(&'g FloorGrid),

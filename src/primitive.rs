@@ -726,9 +726,12 @@ mod tests {
     #[test]
     fn a_roof_fitted_off_level_far_from_the_sensor_is_no_ground() {
         let p = Params::gpp2();
-        let sensor = DVec3::new(0.0, 0.0, 1.8);
-        // A 2 m x 1.6 m patch centred 20 m from the sensor at height z0,
-        // rising away from the sensor by `deg`.
+        // Points local to an origin far from the world's (a local/world
+        // mix-up in the rule would judge them elsewhere).
+        let origin = DVec3::new(1000.0, -500.0, 30.0);
+        let sensor = origin + DVec3::new(0.0, 0.0, 1.8);
+        // A 2 m x 1.6 m patch centred 20 m from the sensor at height z0
+        // (local), rising away from the sensor by `deg`.
         let patch = |z0: f64, deg: f64| -> Vec<Vec3> {
             let slope = deg.to_radians().tan();
             let mut pts = Vec::new();
@@ -743,7 +746,7 @@ mod tests {
         };
         let ground = |pts: &[Vec3]| {
             shape(
-                DVec3::ZERO,
+                origin,
                 pts,
                 &p,
                 sensor,

@@ -803,6 +803,21 @@ fn polygons_carry_ground_density_and_scans() {
     let doc: serde_json::Value = serde_json::from_str(&out).unwrap();
     let all = doc["polygons"].as_array().unwrap();
     let up = |p: &serde_json::Value| p["normal"][2].as_f64().unwrap().abs() > 0.99;
+    // The keys of the JS polygon objects (`POLYGON_KEYS` in
+    // tests/js/api.test.mjs), whatever their order.
+    let keys: Vec<&str> = all[0]
+        .as_object()
+        .unwrap()
+        .keys()
+        .map(|k| k.as_str())
+        .collect();
+    let js = [
+        "id", "normal", "offset", "vertices", "area", "support", "density", "ground", "bornScan",
+        "lastScan",
+    ];
+    let mut sorted = js.to_vec();
+    sorted.sort_unstable();
+    assert_eq!(keys, sorted, "serde_json's map sorts its keys");
     let floor = all.iter().find(|p| up(p)).expect("the floor");
     let wall = all.iter().find(|p| !up(p)).expect("the wall");
     assert_eq!(floor["ground"].as_bool(), Some(true), "{out}");

@@ -315,7 +315,7 @@ impl CascadePolicy {
 /// What tells ground from other near-horizontal planes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum GroundBy {
-    /// At least `groundDepth` below the viewpoint (a sensor on a vehicle).
+    /// `groundDepth` below the sensor's height (a sensor on a vehicle).
     Viewpoint,
     /// On the cloud's local floor: the lowest points of each 4 m column,
     /// and up to 0.5 m above them (a curb, a sidewalk, a ramp's rise).

@@ -553,8 +553,8 @@ impl PlanePool {
     /// inliers (positions, in voxel order) and their coordinates, or `None`
     /// when no plane has `min_inliers`.
     /// `viewpoint` is the sensor in local coordinates; `ground` tells which
-    /// planes are counted with the ground distance (judged where each
-    /// hypothesis was drawn).
+    /// planes are counted with the ground distance (by the local floor
+    /// where drawn, or below the viewpoint itself: `GroundRule::at_point`).
     pub(crate) fn best_plane(
         &mut self,
         params: &Params,

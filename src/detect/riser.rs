@@ -815,7 +815,9 @@ fn on_one_line(
     spacing: Spacing,
     cos_parallel: f64,
 ) -> bool {
-    if f.dir.dot(g.dir).abs() < cos_parallel
+    // A face without points has no extent (and an infinite gap).
+    if !(f.lo <= f.hi && g.lo <= g.hi)
+        || f.dir.dot(g.dir).abs() < cos_parallel
         || f.dir.perp().dot(g.at - f.at).abs() > tol
         || g.dir.perp().dot(f.at - g.at).abs() > tol
     {
@@ -1164,10 +1166,36 @@ mod tests {
         };
         // Seen from the foot, 30-50 m away: one face of every point.
         assert_eq!(joined(Some(DVec2::new(-10.0, 0.0))), vec![88]);
-        // From a foot among them, the near gaps are too wide.
+        // From the origin, the gaps whose middles lie 21.75 and 24.25 m
+        // away may be 1.18 and 1.47 m wide (the square of the range over
+        // 20 m): those two stay, the farther ones join.
+        assert_eq!(joined(Some(DVec2::ZERO)), vec![11, 11, 66]);
+        // From a foot among them, every gap is within 20 m: too wide.
         assert_eq!(joined(Some(DVec2::new(25.0, 0.0))).len(), 8);
         // Seen from nowhere known, the gaps are too wide everywhere.
         assert_eq!(joined(None).len(), 8);
+        // A face without points (no extent: `lo` > `hi`) joins nothing,
+        // whichever way round, on a line along no axis.
+        let d = DVec2::new(0.6, 0.8);
+        let face = |at: f64, lo: f64, hi: f64, points: Vec<u32>| Face {
+            lower,
+            upper,
+            at: d * at,
+            dir: d,
+            lo,
+            hi,
+            points,
+        };
+        let empty = face(30.0, f64::INFINITY, f64::NEG_INFINITY, Vec::new());
+        let full = face(40.0, 0.0, 1.0, vec![0]);
+        let spacing = Spacing {
+            foot: Some(DVec2::ZERO),
+            range: 20.0,
+        };
+        let cos = 5f64.to_radians().cos();
+        assert!(super::on_one_line(&full, &full, 0.08, 1.0, spacing, cos));
+        assert!(!super::on_one_line(&empty, &full, 0.08, 1.0, spacing, cos));
+        assert!(!super::on_one_line(&full, &empty, 0.08, 1.0, spacing, cos));
     }
 
     #[test]

@@ -652,7 +652,7 @@ pub struct PolygonView {
     pub support: u64,
     /// Support points per m^2 of outline.
     pub density: f64,
-    /// Near-horizontal and below the sensor: road, sidewalk.
+    /// Ground (road, sidewalk, plaza): by the local floor in one-shot detection, by `groundDepth` under the sensor in the scenario.
     pub ground: bool,
     /// Scan in which it was detected (0 for one-shot detection).
     pub born_scan: u64,
