@@ -1131,9 +1131,9 @@ mod tests {
 
     #[test]
     fn far_faces_on_one_line_join_across_the_gaps_the_rings_leave() {
-        // A curb's face 20-40 m along y = 0 from a foot at x = -10: runs of
-        // points 1 m long every 2.5 m (gaps of 1.5 m, over `2 * alpha`),
-        // each the face of one segment of a jagged outline.
+        // A curb's face along y = 0 at x = 20-39: runs of points 1 m long
+        // every 2.5 m (gaps of 1.5 m, over `2 * alpha`), each the face of
+        // one segment of a jagged outline.
         use super::{merge_faces, Face, Plan, Spacing};
         use crate::geometry::Plane;
         use glam::{DVec2, Vec3};
