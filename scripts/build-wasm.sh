@@ -73,6 +73,18 @@ if [ "${FORCE:-0}" != 1 ] && [ "$fresh" = 1 ] && [ "$(cat pkg/.inputs.sha256 2>/
   exit 0
 fi
 
+# Panic locations in dependencies name their files by where cargo keeps
+# their sources, under the builder's home
+# (/root/.cargo/registry/src/index.crates.io-<hash>/spade-2.15.1/src/...):
+# those prefixes become `crates`, so that the wasm neither carries nor
+# depends on the builder's paths (and is some 0.2 kB gzipped smaller).
+# Cargo joins this array to .cargo/config.toml's rustflags.
+flags=""
+for d in "${CARGO_HOME:-$HOME/.cargo}"/registry/src/*/; do
+  [ -d "$d" ] && flags+="'--remap-path-prefix=$d=',"
+done
+remap=(--config "target.wasm32-unknown-unknown.rustflags=[${flags%,}]")
+
 # wasm-pack's own update check needs the internet; its warning is noise here.
 quiet() { grep -v -e "failed to get wasm-pack version" -e "no LICENSE file" || true; }
 # The main builds first, then the simulator's: cargo rebuilds the crate when
@@ -81,7 +93,7 @@ for i in "${!targets[@]}"; do
   dir=${dirs[$i]}
   echo "build-wasm: wasm-pack build --release --target ${targets[$i]} -> $dir/polyscene.js"
   wasm-pack --log-level warn build --release --target "${targets[$i]}" \
-    --out-dir "$dir" --out-name polyscene 2>&1 | quiet
+    --out-dir "$dir" --out-name polyscene -- "${remap[@]}" 2>&1 | quiet
   [ -f "$dir/polyscene_bg.wasm" ] || { echo "build-wasm: ${targets[$i]} build failed" >&2; exit 1; }
 done
 # The simulator: built into a scratch folder (wasm-pack writes its own
@@ -92,7 +104,7 @@ for i in "${!targets[@]}"; do
   rm -rf "$dir.sim"
   wasm-pack --log-level warn build --release --target "${targets[$i]}" \
     --out-dir "$dir.sim" --out-name polyscene_sim --no-pack \
-    -- --no-default-features --features wasm-sim 2>&1 | quiet
+    -- --no-default-features --features wasm-sim "${remap[@]}" 2>&1 | quiet
   [ -f "$dir.sim/polyscene_sim_bg.wasm" ] || { echo "build-wasm: ${targets[$i]} wasm-sim build failed" >&2; exit 1; }
   rm -f "$dir"/polyscene_sim*
   mv "$dir.sim"/polyscene_sim* "$dir/"
