@@ -247,6 +247,19 @@ fn span(pts: impl Iterator<Item = DVec2>, dir: DVec2) -> (f64, f64) {
     })
 }
 
+/// The band a primitive's expansion takes points from, along the frame's
+/// second axis (up the plane, for walls): for a riser on level ground
+/// (less than `width` high: detection accepts nothing narrower than
+/// `minWidth`) its outline's span, for any other primitive all of it.
+pub(crate) fn strip_span(ring: &[DVec2], width: f64) -> (f64, f64) {
+    let (lo, hi) = span(ring.iter().copied(), DVec2::Y);
+    if hi - lo < width {
+        (lo, hi)
+    } else {
+        (f64::NEG_INFINITY, f64::INFINITY)
+    }
+}
+
 /// Smallest width of the outline's convex hull (rotating calipers over the
 /// hull edges), in metres.
 pub fn min_width(ring: &[DVec2]) -> f64 {
