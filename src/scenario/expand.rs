@@ -475,7 +475,8 @@ mod tests {
     #[test]
     fn a_riser_grows_along_its_curb_but_not_up_a_car_side_in_front_of_it() {
         // A curb's face as the riser step makes it: the 15 cm rectangle
-        // over 3 m of the plane y = 0 (local y is the height).
+        // over 3 m of the plane y = 0 (local x runs along the world's -x,
+        // local y is the height): world x from -3 to 0.
         let plane = Plane::from_point_normal(DVec3::ZERO, DVec3::Y);
         let outline = vec![
             DVec2::ZERO,
@@ -490,18 +491,18 @@ mod tests {
             outline,
             ..square(1, 1.0)
         };
-        // The face, on to x = 6 m, and a car's side 1 cm in front of it
-        // (within the 3 cm gate), from 0.3 m up to 1.5 m over x = 1..5 m.
+        // The face, on to x = -6 m, and a car's side 1 cm in front of it
+        // (within the 3 cm gate), from 0.3 m up to 1.5 m over x = -5..-1 m.
         let mut pts = Vec::new();
         for i in 0..=60 {
             for k in 1..=7 {
-                pts.extend([i as f64 * 0.1, 0.0, k as f64 * 0.02]);
+                pts.extend([-0.1 * i as f64, 0.0, k as f64 * 0.02]);
             }
         }
         let face = pts.len() / 3;
         for i in 10..=50 {
             for k in 0..=24 {
-                pts.extend([i as f64 * 0.1, -0.01, 0.3 + k as f64 * 0.05]);
+                pts.extend([-0.1 * i as f64, -0.01, 0.3 + k as f64 * 0.05]);
             }
         }
         let cloud = Cloud::from_flat_f64(&pts, 3).unwrap();
@@ -523,13 +524,14 @@ mod tests {
         // All of the face, none of the car.
         assert_eq!(taken, face);
         assert!(alive[face..].iter().all(|&a| a));
-        // Still a 15 cm strip, now 6 m long.
+        // Still a 15 cm strip, now 6 m long (to the centre of the last
+        // 0.2 m footprint cell).
         let (lo, hi) = prim.outline.iter().fold(
             (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
             |(lo, hi), &v| (lo.min(v), hi.max(v)),
         );
         assert!(hi.y - lo.y < 0.2, "{:?}", prim.outline);
-        assert!(hi.x - lo.x > 5.9, "{:?}", prim.outline);
+        assert!((5.8..6.2).contains(&(hi.x - lo.x)), "{:?}", prim.outline);
     }
 
     #[test]
