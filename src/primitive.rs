@@ -248,8 +248,8 @@ fn span(pts: impl Iterator<Item = DVec2>, dir: DVec2) -> (f64, f64) {
 }
 
 /// The band a primitive's expansion takes points from, along the frame's
-/// second axis (up the plane, for walls): for a riser on level ground
-/// (less than `width` high: detection accepts nothing narrower than
+/// second axis (up the plane, for walls): for a riser (an outline spanning
+/// less than `width` along it: detection accepts nothing narrower than
 /// `minWidth`) its outline's span, for any other primitive all of it.
 pub(crate) fn strip_span(ring: &[DVec2], width: f64) -> (f64, f64) {
     let (lo, hi) = span(ring.iter().copied(), DVec2::Y);
