@@ -207,11 +207,12 @@ fn drive_through(layout: Layout) {
     )
     .unwrap();
     // Curbs (15 cm faces between the road and the sidewalks) become risers
-    // from each scan's points, and grow by merging the pieces that
-    // continue them, as rectangles (measured: 6 of the crossing's 8 curbs
-    // of 1 m^2 or more; 3 of 4 then when their outlines were traced from 0.2 m
-    // cells; the street's two run the whole 449 m of the scene, and the
-    // pieces found cover less than half of what the drive saw of them).
+    // from each scan's points and the pool's, and grow by merging the
+    // pieces that continue them, as rectangles (measured: 7 of the
+    // crossing's 8 curbs of 1 m^2 or more, 6 without the pool's; 3 of 4
+    // then when their outlines were traced from 0.2 m cells; the street's
+    // two run the whole 449 m of the scene, and the pieces found cover
+    // less than half of what the drive saw of them).
     if layout == Layout::Crossing {
         let (found, all) = common::found_of_kind(&inc, d.scene(), SurfaceKind::Curb);
         assert!(found >= 4, "{found} of {all} curbs");
@@ -337,7 +338,7 @@ fn drive_through(layout: Layout) {
     // Measured (found / eligible): street road 1/1, sidewalks 2/2, vehicle
     // sides 40/66, ends 63/75; crossing road 1/1, ramp 1/1, sidewalks and
     // plaza 0.15 m above the road 4/4, vehicle sides 38/93, ends 48/78.
-    // Curbs (street 0/2, crossing 5/8) are not asserted: a riser needs
+    // Curbs (street 0/2, crossing 7/8) are not asserted: a riser needs
     // both surfaces found beside it (docs/LIMITATIONS.md).
     let kinds = kinds_found(&d, &inc);
     eprintln!("{layout:?} kinds: {kinds:?}");

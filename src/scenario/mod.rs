@@ -356,9 +356,11 @@ impl Scenario {
             self.primitives.push(prim);
         }
         // 2b. Risers (curbs, steps) between the near-horizontal primitives
-        //     this scan reached, as one-shot detection finds them.
+        //     this scan reached, as one-shot detection finds them, from the
+        //     scan's and the pool's points; the pool holds the pieces too
+        //     small to keep.
         near.extend_from_slice(&report.added);
-        if self.params.expansion && !empty {
+        let held = if self.params.expansion && !empty {
             self.add_risers(
                 cloud,
                 n,
@@ -367,14 +369,18 @@ impl Scenario {
                 &mut labels,
                 &mut alive,
                 &mut report,
-            );
-        }
+            )
+        } else {
+            Vec::new()
+        };
         let p = &self.params;
         report.explained_from_pool = alive[n..].iter().filter(|&&a| !a).count();
         if !empty {
             let seen = Surfaces::new(&self.primitives, &near, |q| surfaces::seen_slack(q, p));
             self.pool
-                .carry(cloud, n, &alive, &selection, scan, p, &|w| seen.holds(w, p));
+                .carry(cloud, n, &alive, &selection, &held, scan, p, &|w| {
+                    seen.holds(w, p)
+                });
         }
         report.pool_points = self.pool.len();
         labels.truncate(n);
@@ -407,13 +413,16 @@ impl Scenario {
     }
 
     /// Step 2b of [`Scenario::add_cloud`]: the risers between the
-    /// near-horizontal primitives among `near` (ids), from this scan's
-    /// points (the first `n` of `cloud`; a curb's face lies within the
-    /// expansion gates of the road and the sidewalk, so the pool holds
-    /// little of it), which they take from the primitive they were
-    /// labelled with. A riser of `minArea` becomes a new primitive (the
-    /// merge then joins it to one an earlier scan found there); a smaller
-    /// piece grows the primitive it continues, or is dropped.
+    /// near-horizontal primitives among `near` (ids), from the points of
+    /// `cloud` (the scan's first `n`, then the pool's), which they take
+    /// from the primitive they were labelled with. A riser of `minArea`
+    /// becomes a new primitive (the merge then joins it to one an earlier
+    /// scan found there); a smaller piece grows the primitive it
+    /// continues, or its points are returned (indices into `cloud`), for
+    /// the pool to hold: a curb's face lies within the expansion gates of
+    /// the road and the sidewalk, so the pool would not keep it, and a
+    /// curb seen a few metres at a time between parked cars adds up only
+    /// there.
     #[allow(clippy::too_many_arguments)]
     fn add_risers(
         &mut self,
@@ -424,7 +433,7 @@ impl Scenario {
         labels: &mut [u32],
         alive: &mut [bool],
         report: &mut ScanReport,
-    ) {
+    ) -> Vec<u32> {
         let (p, scan) = (&self.params, self.scans);
         let index_of =
             |prims: &[Primitive], id: u32| prims.binary_search_by_key(&id, |q| q.id).ok();
@@ -440,8 +449,8 @@ impl Scenario {
             prims,
             &bound,
             &slot,
-            &labels[..n],
-            &cloud.points[..n],
+            labels,
+            &cloud.points,
             cloud.origin,
             sensor,
             p,
@@ -458,6 +467,7 @@ impl Scenario {
         let (large, small): (Vec<_>, Vec<_>) =
             found.into_iter().partition(|(r, _)| r.area >= p.min_area);
         let mut ids: Vec<u32> = near.to_vec();
+        let mut held = Vec::new();
         for (mut riser, points) in large.into_iter().chain(small) {
             // The slot of the primitive a small piece continues.
             let into = if riser.area < p.min_area {
@@ -465,7 +475,10 @@ impl Scenario {
                     index_of(&self.primitives, id)
                         .filter(|&k| crate::merge::mergeable(&self.primitives[k], &riser, p))
                 });
-                let Some(k) = continued else { continue };
+                let Some(k) = continued else {
+                    held.extend_from_slice(&points);
+                    continue;
+                };
                 Some(k)
             } else {
                 None
@@ -509,6 +522,7 @@ impl Scenario {
                 }
             }
         }
+        held
     }
 
     /// Move `scan` (world frame, seen from `sensor`) by the last scan's

@@ -14,11 +14,17 @@
 //!    takes them (they were seen, never counted);
 //! 2. [`Pool::select`]: detection gets every live point of the scan and the
 //!    live pool points in voxels the scan's live points do not reach (there
-//!    the scan's points are the newer evidence of the same place);
-//! 3. [`Pool::carry`]: after detection, the pool becomes the scan's live
-//!    points, one a voxel (the first in scan order), then the pool's points
-//!    detection saw and left, while younger than `poolScans` scans; newest
-//!    first, cut at `poolMaxPoints`.
+//!    the scan's points are the newer evidence of the same place), but not
+//!    the held points (below);
+//! 3. [`Pool::carry`]: after detection and the riser step, the pool becomes
+//!    the scan's live points, one a voxel (the first in scan order), then
+//!    the pool's points detection saw and left, while younger than
+//!    `poolScans` scans; newest first, cut at `poolMaxPoints`. The points of
+//!    a riser's piece too small to keep are *held*: kept although expansion
+//!    took them into the road or the sidewalk (a curb's face lies within
+//!    their gates), for the riser step alone, which runs on the scan's and
+//!    the pool's points, so that a curb seen a few metres at a time between
+//!    parked cars adds up to a riser.
 //!
 //! So the pool's size is bounded by the cap and, in practice, by the
 //! unexplained surface seen in the last `poolScans` scans at one point a
@@ -48,6 +54,10 @@ pub(crate) struct Pool {
     mm: Vec<i64>,
     /// Per point, the scan that saw it; newest first.
     seen: Vec<u64>,
+    /// The points held for the riser step (ascending positions): pieces of
+    /// a curb's face too small to keep. Detection does not see them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    held: Vec<u64>,
 }
 
 /// Which points of a joined cloud go to detection, and what the pool keeps
@@ -141,8 +151,13 @@ impl Pool {
             sel.scan_mm.push(w);
         }
         sel.voxels = ids.len();
+        let mut held = 0;
         for k in 0..self.len() {
             let i = n + k;
+            if self.held.get(held) == Some(&(k as u64)) {
+                held += 1;
+                continue;
+            }
             if alive[i] && !ids.contains_key(&grid.voxel(self.world_mm(k))) {
                 rest.push(i as u32);
             }
@@ -155,7 +170,10 @@ impl Pool {
     /// voxel, then the pool points of `sel` still alive and younger than
     /// `poolScans` scans, cut at `poolMaxPoints`. A point for which `known`
     /// is true (it lies on a known polygon, a little off its plane) is not
-    /// kept (see `Surfaces::holds` in `scenario/surfaces.rs`).
+    /// kept (see `Surfaces::holds` in `scenario/surfaces.rs`). The points
+    /// `held` (indices into `cloud`: a riser's piece too small to keep) are
+    /// kept whatever `alive` and `known` say, the scan's one a voxel, the
+    /// pool's while younger than `poolScans` scans.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn carry(
         &mut self,
@@ -163,6 +181,7 @@ impl Pool {
         n: usize,
         alive: &[bool],
         sel: &Selection,
+        held: &[u32],
         scan: u64,
         params: &Params,
         known: &dyn Fn(DVec3) -> bool,
@@ -171,7 +190,18 @@ impl Pool {
         let anchor = origin_mm(cloud.origin);
         let mut mm = Vec::new();
         let mut seen = Vec::new();
+        let mut kept_held = Vec::new();
         if enabled(params) {
+            // The held points, the pool's marked by position.
+            let mut hold = vec![false; self.len()];
+            let mut held_scan = Vec::new();
+            for &i in held {
+                match (i as usize).checked_sub(n) {
+                    Some(k) if k < hold.len() => hold[k] = true,
+                    Some(_) => {}
+                    None => held_scan.push(i as usize),
+                }
+            }
             let mut kept = vec![false; sel.voxels];
             for (j, &i) in sel.rest[..sel.from_scan].iter().enumerate() {
                 if seen.len() >= cap {
@@ -185,19 +215,46 @@ impl Pool {
                     seen.push(scan);
                 }
             }
+            let grid = Grid::new(params);
+            let mut voxels: GridMap<[i64; 3], u32> = GridMap::default();
+            for &i in &held_scan {
+                let p = cloud.points[i].to_array();
+                let w = [0, 1, 2].map(|a| anchor[a] + self::mm(p[a] as f64));
+                let next = voxels.len() as u32;
+                if seen.len() < cap && *voxels.entry(grid.voxel(w)).or_insert(next) == next {
+                    kept_held.push(seen.len() as u64);
+                    mm.extend((0..3).map(|a| w[a] - anchor[a]));
+                    seen.push(scan);
+                }
+            }
+            // The pool's, in its order (newest first): those detection saw
+            // and left, and the held ones.
+            let mut left = vec![false; self.len()];
             for &i in &sel.rest[sel.from_scan..] {
-                let (i, k) = (i as usize, i as usize - n);
+                left[i as usize - n] = true;
+            }
+            for k in 0..self.len() {
+                let i = n + k;
                 if seen.len() >= cap {
                     break;
                 }
-                if alive[i] && scan.saturating_sub(self.seen[k]) < age && !known(cloud.world(i)) {
+                let young = scan.saturating_sub(self.seen[k]) < age;
+                if young && (hold[k] || left[k] && alive[i] && !known(cloud.world(i))) {
+                    if hold[k] {
+                        kept_held.push(seen.len() as u64);
+                    }
                     let w = self.world_mm(k);
                     mm.extend((0..3).map(|a| w[a] - anchor[a]));
                     seen.push(self.seen[k]);
                 }
             }
         }
-        *self = Pool { anchor, mm, seen };
+        *self = Pool {
+            anchor,
+            mm,
+            seen,
+            held: kept_held,
+        };
     }
 
     /// Check a restored pool: lengths agree, no point is from a scan not
@@ -214,6 +271,11 @@ impl Pool {
         }
         if self.seen.iter().any(|&s| s >= scans) || self.seen.windows(2).any(|w| w[0] < w[1]) {
             return bad("ages out of order or from a later scan");
+        }
+        if self.held.windows(2).any(|w| w[0] >= w[1])
+            || self.held.last().is_some_and(|&h| h as usize >= self.len())
+        {
+            return bad("held points out of order or beyond its points");
         }
         let limit = (crate::cloud::MAX_COORDINATE * 1000.0) as i64;
         let out = |v: i64| !(-limit..=limit).contains(&v);
@@ -270,5 +332,64 @@ impl Grid {
             }
             q
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cloud(pts: &[[f64; 3]]) -> Cloud {
+        let flat: Vec<f64> = pts.iter().flatten().copied().collect();
+        Cloud::from_flat_f64(&flat, 3).unwrap()
+    }
+
+    #[test]
+    fn held_points_stay_out_of_detection_while_the_riser_step_holds_them() {
+        let p = Params::gpp2();
+        let mut pool = Pool::default();
+        // Scan 0: three points, all taken by expansion and on a known
+        // surface; the riser step holds the first and the third.
+        let c = cloud(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]);
+        let dead = [false; 3];
+        let sel = pool.select(&c, 3, &dead, &p);
+        assert!(sel.rest.is_empty());
+        pool.carry(&c, 3, &dead, &sel, &[0, 2], 0, &p, &|_| true);
+        assert_eq!((pool.len(), &pool.held[..]), (2, &[0, 1][..]));
+        assert_eq!(pool.world_mm(1), [2000, 0, 0]);
+        assert!(pool.validate(1).is_ok());
+        // Scan 1: one point of its own, then the pool's two, all left by
+        // expansion. Detection sees the scan's point, not the held ones.
+        let joined = pool.join(&cloud(&[[5.0, 0.0, 0.0]])).unwrap();
+        let alive = [true; 3];
+        let sel = pool.select(&joined, 1, &alive, &p);
+        assert_eq!(sel.rest, vec![0]);
+        // The riser step holds the second again; the first, no longer
+        // held, leaves with what detection never saw.
+        pool.carry(&joined, 1, &alive, &sel, &[2], 1, &p, &|_| false);
+        assert_eq!((pool.len(), &pool.held[..]), (2, &[1][..]));
+        assert_eq!(pool.world_mm(0), [5000, 0, 0]);
+        assert_eq!((pool.world_mm(1), pool.seen[1]), ([2000, 0, 0], 0));
+        // Held, it still ages out after `poolScans` scans.
+        let old = p.pool_scans as u64;
+        let joined = pool.join(&cloud(&[[9.0, 0.0, 0.0]])).unwrap();
+        let sel = pool.select(&joined, 1, &[false; 3], &p);
+        pool.carry(&joined, 1, &[false; 3], &sel, &[2], old, &p, &|_| false);
+        assert_eq!(pool.len(), 0);
+    }
+
+    #[test]
+    fn a_snapshot_s_held_points_must_be_in_order_and_among_its_points() {
+        let mut pool = Pool {
+            anchor: [0; 3],
+            mm: vec![0; 6],
+            seen: vec![1, 0],
+            held: vec![0, 1],
+        };
+        assert!(pool.validate(2).is_ok());
+        for held in [vec![1, 0], vec![0, 0], vec![2]] {
+            pool.held = held;
+            assert!(pool.validate(2).is_err(), "{:?}", pool.held);
+        }
     }
 }
