@@ -170,7 +170,8 @@ options! {
     /// 20.
     pool_scans: usize = pool_scans, "scans", Check::Count(0, 10_000);
     /// Voxel side of the pool (m): it keeps one point a voxel, the newest,
-    /// in a grid anchored at the world origin. Default 0.1.
+    /// in a grid anchored at the world origin (and one a voxel of the
+    /// curb faces it holds for the riser step). Default 0.1.
     pool_voxel: f64 = pool_voxel, "m", Check::Between(0.01, 10.0);
     /// Most points the pool holds; the oldest go first. Bounds its memory
     /// (32 bytes a point) and the detection time it adds; 0 turns the pool

@@ -460,8 +460,8 @@ impl Scenario {
         // Those large enough first, each a new primitive; then the pieces
         // too small to stand alone (a scan sees a few metres of a curb),
         // each taken into the primitive it continues (`merge::mergeable`:
-        // a riser in view or one just added) at once, or dropped. A small
-        // piece never stands alone, not even until the merge step: there it
+        // a riser in view or one just added) at once, or held in the pool
+        // (its points returned). A small piece never stands alone, not even until the merge step: there it
         // could miss the primitive it continued (merged into another
         // first) and stay, a few centimetres wide.
         let (large, small): (Vec<_>, Vec<_>) =

@@ -1,6 +1,7 @@
 //! The pool of unexplained points: what no primitive explained in the last
 //! `poolScans` scans, in the world frame, one point per voxel of side
-//! `poolVoxel`, at most `poolMaxPoints` of them.
+//! `poolVoxel` (and one held point a voxel, below), at most
+//! `poolMaxPoints` of them.
 //!
 //! A surface that comes into view a little at a time (a far facade, the end
 //! of a car, a curb seen along a drive, a ramp at grazing range) gives each
@@ -82,7 +83,7 @@ fn origin_mm(origin: DVec3) -> [i64; 3] {
 }
 
 impl Pool {
-    /// Points held.
+    /// Points in the pool, held or not.
     pub(crate) fn len(&self) -> usize {
         self.seen.len()
     }
@@ -114,7 +115,7 @@ impl Pool {
 
     /// The detection input of a joined cloud (`n` scan points, then the
     /// pool's) after expansion: every live scan point, and each live pool
-    /// point whose voxel holds no live scan point.
+    /// point whose voxel holds no live scan point, but no held one.
     pub(crate) fn select(
         &self,
         cloud: &Cloud,
@@ -171,9 +172,10 @@ impl Pool {
     /// `poolScans` scans, cut at `poolMaxPoints`. A point for which `known`
     /// is true (it lies on a known polygon, a little off its plane) is not
     /// kept (see `Surfaces::holds` in `scenario/surfaces.rs`). The points
-    /// `held` (indices into `cloud`: a riser's piece too small to keep) are
-    /// kept whatever `alive` and `known` say, the scan's one a voxel, the
-    /// pool's while younger than `poolScans` scans.
+    /// `held` (indices into `cloud`: a riser's piece too small to keep) that
+    /// the pool would not keep otherwise are kept whatever `alive` and
+    /// `known` say, while younger than `poolScans` scans, one a voxel (a
+    /// scan's over an older one).
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn carry(
         &mut self,
@@ -217,7 +219,12 @@ impl Pool {
             }
             let grid = Grid::new(params);
             let mut voxels: GridMap<[i64; 3], u32> = GridMap::default();
+            // (A live one is the scan's like any other, kept or thinned
+            // above.)
             for &i in &held_scan {
+                if alive[i] {
+                    continue;
+                }
                 let p = cloud.points[i].to_array();
                 let w = [0, 1, 2].map(|a| anchor[a] + self::mm(p[a] as f64));
                 let next = voxels.len() as u32;
@@ -239,8 +246,10 @@ impl Pool {
                     break;
                 }
                 let young = scan.saturating_sub(self.seen[k]) < age;
-                if young && (hold[k] || left[k] && alive[i] && !known(cloud.world(i))) {
-                    if hold[k] {
+                // One held point a voxel: the scan's newer one wins.
+                let hold = hold[k] && !voxels.contains_key(&grid.voxel(self.world_mm(k)));
+                if young && (hold || left[k] && alive[i] && !known(cloud.world(i))) {
+                    if hold {
                         kept_held.push(seen.len() as u64);
                     }
                     let w = self.world_mm(k);
@@ -258,8 +267,9 @@ impl Pool {
     }
 
     /// Check a restored pool: lengths agree, no point is from a scan not
-    /// yet made (`scans` made so far), ages are newest first, and every
-    /// coordinate lies within the accepted range.
+    /// yet made (`scans` made so far), ages are newest first, the held
+    /// positions ascend and lie among the points, and every coordinate
+    /// lies within the accepted range.
     pub(crate) fn validate(&self, scans: u64) -> Result<()> {
         let bad = |what: &str| {
             Err(Error::Invalid(format!(
@@ -273,7 +283,7 @@ impl Pool {
             return bad("ages out of order or from a later scan");
         }
         if self.held.windows(2).any(|w| w[0] >= w[1])
-            || self.held.last().is_some_and(|&h| h as usize >= self.len())
+            || self.held.last().is_some_and(|&h| h >= self.len() as u64)
         {
             return bad("held points out of order or beyond its points");
         }
@@ -364,9 +374,11 @@ mod tests {
         let alive = [true; 3];
         let sel = pool.select(&joined, 1, &alive, &p);
         assert_eq!(sel.rest, vec![0]);
-        // The riser step holds the second again; the first, no longer
+        // The riser step holds the second again, taken by expansion and on
+        // a known surface (below x = 3 m) as before; the first, no longer
         // held, leaves with what detection never saw.
-        pool.carry(&joined, 1, &alive, &sel, &[2], 1, &p, &|_| false);
+        let taken = [true, true, false];
+        pool.carry(&joined, 1, &taken, &sel, &[2], 1, &p, &|w| w.x < 3.0);
         assert_eq!((pool.len(), &pool.held[..]), (2, &[1][..]));
         assert_eq!(pool.world_mm(0), [5000, 0, 0]);
         assert_eq!((pool.world_mm(1), pool.seen[1]), ([2000, 0, 0], 0));
@@ -376,6 +388,30 @@ mod tests {
         let sel = pool.select(&joined, 1, &[false; 3], &p);
         pool.carry(&joined, 1, &[false; 3], &sel, &[2], old, &p, &|_| false);
         assert_eq!(pool.len(), 0);
+    }
+
+    #[test]
+    fn held_points_are_one_a_voxel_and_never_a_second_copy_of_a_live_one() {
+        let p = Params::gpp2();
+        let mut pool = Pool::default();
+        // Scan 0 holds a point at 2 m.
+        let c = cloud(&[[2.0, 0.0, 0.0]]);
+        let sel = pool.select(&c, 1, &[false], &p);
+        pool.carry(&c, 1, &[false], &sel, &[0], 0, &p, &|_| false);
+        assert_eq!(pool.held, vec![0]);
+        // Scan 1 holds a point 2 cm from it (the same 0.1 m voxel) and the
+        // old one again: the newer is kept. Its other point, held but left
+        // by expansion, is kept once, as the scan's live points are.
+        let joined = pool
+            .join(&cloud(&[[2.02, 0.0, 0.0], [7.0, 0.0, 0.0]]))
+            .unwrap();
+        let alive = [false, true, false];
+        let sel = pool.select(&joined, 2, &alive, &p);
+        assert_eq!(sel.rest, vec![1]);
+        pool.carry(&joined, 2, &alive, &sel, &[0, 1, 2], 1, &p, &|_| false);
+        let kept: Vec<[i64; 3]> = (0..pool.len()).map(|k| pool.world_mm(k)).collect();
+        assert_eq!(kept, vec![[7000, 0, 0], [2020, 0, 0]]);
+        assert_eq!(pool.held, vec![1]);
     }
 
     #[test]
