@@ -460,10 +460,10 @@ impl Scenario {
         // Those large enough first, each a new primitive; then the pieces
         // too small to stand alone (a scan sees a few metres of a curb),
         // each taken into the primitive it continues (`merge::mergeable`:
-        // a riser in view or one just added) at once, or held in the pool
-        // (its points returned). A small piece never stands alone, not even until the merge step: there it
-        // could miss the primitive it continued (merged into another
-        // first) and stay, a few centimetres wide.
+        // a riser in view or one just added) at once, or held in the pool.
+        // A small piece never stands alone, not even until the merge step:
+        // there it could miss the primitive it continued (merged into
+        // another first) and stay, a few centimetres wide.
         let (large, small): (Vec<_>, Vec<_>) =
             found.into_iter().partition(|(r, _)| r.area >= p.min_area);
         let mut ids: Vec<u32> = near.to_vec();
