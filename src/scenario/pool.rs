@@ -82,6 +82,13 @@ fn origin_mm(origin: DVec3) -> [i64; 3] {
     origin.to_array().map(mm)
 }
 
+/// World millimetres of point `i` of `cloud`, whose origin is `o`
+/// ([`origin_mm`]).
+fn point_mm(cloud: &Cloud, o: [i64; 3], i: usize) -> [i64; 3] {
+    let p = cloud.points[i].to_array();
+    [0, 1, 2].map(|a| o[a] + mm(p[a] as f64))
+}
+
 impl Pool {
     /// Points in the pool, held or not.
     pub(crate) fn len(&self) -> usize {
@@ -145,8 +152,7 @@ impl Pool {
         sel.scan_mm.reserve(from_scan);
         sel.voxel_of.reserve(from_scan);
         for &i in &rest {
-            let p = cloud.points[i as usize].to_array();
-            let w = [0, 1, 2].map(|a| o[a] + mm(p[a] as f64));
+            let w = point_mm(cloud, o, i as usize);
             let next = ids.len() as u32;
             sel.voxel_of.push(*ids.entry(grid.voxel(w)).or_insert(next));
             sel.scan_mm.push(w);
@@ -225,8 +231,7 @@ impl Pool {
                 if alive[i] {
                     continue;
                 }
-                let p = cloud.points[i].to_array();
-                let w = [0, 1, 2].map(|a| anchor[a] + self::mm(p[a] as f64));
+                let w = point_mm(cloud, anchor, i);
                 let next = voxels.len() as u32;
                 if seen.len() < cap && *voxels.entry(grid.voxel(w)).or_insert(next) == next {
                     kept_held.push(seen.len() as u64);
