@@ -30,6 +30,21 @@
 //!    optimization-based state estimation problems", ICRA 2016).
 //! 5. Iterate until the step is below a tenth of a millimetre (at most
 //!    [`ITERATIONS`]).
+//! 6. *Polygons at odds with the rest.* While the step is one to apply
+//!    (below), the polygon whose pairs change it the most is found by
+//!    leaving each out in turn (the rest re-solved from the refined pose,
+//!    in the directions the rest pins down); when that change moves some
+//!    point of a 50 m scan by more than [`DEADBAND`], the polygon leaves
+//!    the fit, which iterates again at the last gate (at most
+//!    [`MAX_LEFT_OUT`] polygons a scan). A drifted pose moves the points
+//!    on every polygon alike, and the polygons agree on the step; a
+//!    polygon fitted a little off from the one scan it was born in (a
+//!    car's roof 2.5 degrees off level, on the independent bench) pulls
+//!    the scan towards itself alone, and with true poses turned the whole
+//!    map by 0.05 degrees. This is a deletion diagnostic, as Cook's
+//!    distance is for one observation of a least-squares fit, with each
+//!    polygon's pairs as one group. Two polygons off the same way hide
+//!    each other: leaving out either, the other still pulls.
 //!
 //! The result is kept only with at least [`MIN_PAIRS`] pairs and a total
 //! step within `alignReach` (a larger one is no refinement but a different
@@ -52,6 +67,9 @@ const ITERATIONS: usize = 12;
 /// Rotations are measured as the displacement they give at this distance
 /// from the sensor (m), so that the six unknowns have one unit.
 const LEVER: f64 = 10.0;
+
+/// Most polygons left out of one scan's fit as at odds with the rest.
+const MAX_LEFT_OUT: usize = 3;
 
 /// Fewest pairs for a refinement.
 pub const MIN_PAIRS: usize = 100;
@@ -161,68 +179,95 @@ pub(crate) fn align(
     // rot * s + shift.
     let mut rot = DQuat::IDENTITY;
     let mut shift = DVec3::ZERO;
-    let (mut pairs, mut constrained) = (0, 0);
-    for it in 0..ITERATIONS {
+    let mut pairs;
+    let mut constrained = 0;
+    // The polygons left out of the fit (step 6), each paired polygon's
+    // place in `parts` (`u32::MAX`: none) and its share of the normal
+    // equations, kept in the pass that looks for one at odds.
+    let mut left_out = vec![false; prims.len()];
+    let mut slot = vec![u32::MAX; prims.len()];
+    let mut parts: Vec<(usize, System)> = Vec::new();
+    // `checking`: this pass, at the refined pose, keeps each polygon's
+    // share and looks for one at odds instead of taking a step; `left`:
+    // polygons left out so far; the fit stops at iteration `last`.
+    let (mut checking, mut left, mut it, mut last) = (false, 0, 0, ITERATIONS);
+    loop {
         let gate = (reach * 0.5f64.powi(it as i32)).max(floor);
-        let mut h = [[0.0f64; 6]; 6];
-        let mut g = [0.0f64; 6];
+        let mut all = System::default();
+        for &(k, _) in &parts {
+            slot[k] = u32::MAX;
+        }
+        parts.clear();
         pairs = 0;
         for (j, s) in samples.iter().enumerate() {
             let rel = rot * *s + shift;
             let w = at + rel;
-            let mut best: Option<(f64, DVec3)> = None;
+            let mut best: Option<(f64, usize)> = None;
             for &k in &cand[start[j] as usize..start[j + 1] as usize] {
-                let prim = &prims[k as usize];
+                let k = k as usize;
+                let prim = &prims[k];
                 let r = prim.plane.signed_distance(w);
-                if r.abs() >= gate || best.is_some_and(|(b, _)| b.abs() <= r.abs()) {
+                if r.abs() >= gate || best.is_some_and(|(b, _)| b.abs() <= r.abs()) || left_out[k] {
                     continue;
                 }
                 if prim.footprint.is_set(prim.frame.to_local(w)) {
-                    best = Some((r, prim.plane.normal));
+                    best = Some((r, k));
                 }
             }
-            let Some((r, normal)) = best else {
+            let Some((r, k)) = best else {
                 continue;
             };
+            let normal = prims[k].plane.normal;
             let u = r / gate;
             let weight = (1.0 - u * u) * (1.0 - u * u);
             let a = rel.cross(normal) / LEVER;
             let jac = [a.x, a.y, a.z, normal.x, normal.y, normal.z];
-            for p in 0..6 {
-                g[p] += weight * jac[p] * r;
-                for q in p..6 {
-                    h[p][q] += weight * jac[p] * jac[q];
+            all.add(weight, &jac, r);
+            if checking {
+                if slot[k] == u32::MAX {
+                    slot[k] = parts.len() as u32;
+                    parts.push((k, System::default()));
                 }
+                parts[slot[k] as usize].1.add(weight, &jac, r);
             }
             pairs += 1;
         }
         if pairs < MIN_PAIRS {
             return Fit::none(pairs, 0);
         }
-        for p in 0..6 {
-            for q in 0..p {
-                h[p][q] = h[q][p];
-            }
+        if checking {
+            // 6. The polygon at odds with the rest leaves the fit, which
+            //    goes on at the last gate.
+            checking = false;
+            let Some(k) = odd_one(&all, &parts) else {
+                break;
+            };
+            left_out[k] = true;
+            left += 1;
+            last = it + ITERATIONS;
+            continue;
         }
-        let (x, c) = constrained_solve(h, g);
+        let (x, c) = constrained_solve(all.full(), all.g);
         constrained = c;
         let turn = DVec3::new(x[0], x[1], x[2]) / LEVER;
         let step = DVec3::new(x[3], x[4], x[5]);
         let dq = DQuat::from_scaled_axis(turn);
         rot = (dq * rot).normalize();
         shift = dq * shift + step;
+        it += 1;
         let small = step.length() + turn.length() * LEVER < 1e-4;
-        if small && gate <= floor {
+        if small && gate <= floor || it >= last {
+            if left < MAX_LEFT_OUT && kept(rot, shift, reach) {
+                checking = true;
+                continue;
+            }
             break;
         }
     }
+    if !kept(rot, shift, reach) {
+        return Fit::none(pairs, constrained);
+    }
     let angle = rot.angle_between(DQuat::IDENTITY);
-    if !(shift.is_finite() && angle.is_finite()) || shift.length() + angle * LEVER > reach {
-        return Fit::none(pairs, constrained);
-    }
-    if shift.length() + angle * DEADBAND_RANGE <= DEADBAND {
-        return Fit::none(pairs, constrained);
-    }
     // World: w -> at + rot * (w - at) + shift.
     let step =
         DMat4::from_translation(at + shift) * DMat4::from_quat(rot) * DMat4::from_translation(-at);
@@ -234,6 +279,82 @@ pub(crate) fn align(
         shift: shift.length(),
         turn: angle,
     }
+}
+
+/// The weighted normal equations of point-to-plane pairs: `h` in its
+/// upper triangle, `g` the gradient.
+#[derive(Clone, Copy, Default)]
+struct System {
+    h: [[f64; 6]; 6],
+    g: [f64; 6],
+}
+
+// Matrix code reads as the formulas with indices.
+#[allow(clippy::needless_range_loop)]
+impl System {
+    /// `h` made whole from its upper triangle.
+    fn full(&self) -> [[f64; 6]; 6] {
+        let mut h = self.h;
+        for p in 0..6 {
+            for q in 0..p {
+                h[p][q] = h[q][p];
+            }
+        }
+        h
+    }
+
+    /// Add one pair: weight, Jacobian row and residual.
+    #[inline(never)] // two callers; inlined, 64 bytes more wasm
+    fn add(&mut self, weight: f64, jac: &[f64; 6], r: f64) {
+        for p in 0..6 {
+            self.g[p] += weight * jac[p] * r;
+            for q in p..6 {
+                self.h[p][q] += weight * jac[p] * jac[q];
+            }
+        }
+    }
+}
+
+/// Whether the refinement `rot`, `shift` is one to apply: finite, within
+/// `reach` (a larger step is no refinement but a different answer), and
+/// moving some point within [`DEADBAND_RANGE`] of the sensor by more than
+/// [`DEADBAND`].
+fn kept(rot: DQuat, shift: DVec3, reach: f64) -> bool {
+    let angle = rot.angle_between(DQuat::IDENTITY);
+    shift.is_finite()
+        && angle.is_finite()
+        && shift.length() + angle * LEVER <= reach
+        && shift.length() + angle * DEADBAND_RANGE > DEADBAND
+}
+
+/// The polygon most at odds with the rest, from the normal equations at
+/// the refined pose (`all`) and each paired polygon's share of them
+/// (`parts`, by index into the polygons): the one whose pairs, left out
+/// and the rest re-solved from there, change the step the most, when
+/// that change moves some point within [`DEADBAND_RANGE`] by more than
+/// [`DEADBAND`]. A drifted pose moves the points on every polygon alike,
+/// so the polygons agree on the step and none changes it much; a polygon
+/// fitted a little off from the one scan it was born in (a car's roof 2.5
+/// degrees off level) pulls the scan towards itself alone. A direction
+/// only that polygon pins down keeps its value: nothing else gainsays it.
+fn odd_one(all: &System, parts: &[(usize, System)]) -> Option<usize> {
+    let mut worst: Option<(f64, usize)> = None;
+    for (k, part) in parts {
+        let mut rest = *all;
+        for p in 0..6 {
+            rest.g[p] -= part.g[p];
+            for q in p..6 {
+                rest.h[p][q] -= part.h[p][q];
+            }
+        }
+        let (x, _) = constrained_solve(rest.full(), rest.g);
+        let change = DVec3::new(x[3], x[4], x[5]).length()
+            + DVec3::new(x[0], x[1], x[2]).length() / LEVER * DEADBAND_RANGE;
+        if change > DEADBAND && worst.is_none_or(|(w, _)| change > w) {
+            worst = Some((change, *k));
+        }
+    }
+    worst.map(|(_, k)| k)
 }
 
 /// The Gauss-Newton step `x = -H⁺ g` restricted to the eigen-directions of
