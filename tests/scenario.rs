@@ -1010,12 +1010,6 @@ fn exact_poses_are_left_exactly_as_given() {
     assert_eq!(on.primitives(), off.primitives());
 }
 
-/// The drift test on the project's simulator: poses that drift as
-/// in the fidelity bench's `--pose-noise 0.03,0.15` (each scan adds up to
-/// 3 cm and 0.15 degrees about each axis, turning about the sensor,
-/// bounded at 12 cm and 0.6 degrees). Measured (street, 60 scans): share
-/// explained by expansion 0.939, as with exact poses (0.787 without
-/// alignment), 140 polygons against 135, no duplicate pair.
 #[test]
 fn one_polygon_fitted_off_does_not_turn_exact_poses() {
     // The street box seen twice through the true pose; in the first scan
@@ -1071,6 +1065,12 @@ fn one_polygon_fitted_off_does_not_turn_exact_poses() {
     }
 }
 
+/// The drift test on the project's simulator: poses that drift as
+/// in the fidelity bench's `--pose-noise 0.03,0.15` (each scan adds up to
+/// 3 cm and 0.15 degrees about each axis, turning about the sensor,
+/// bounded at 12 cm and 0.6 degrees). Measured (street, 60 scans): share
+/// explained by expansion 0.939, as with exact poses (0.787 without
+/// alignment), 140 polygons against 135, no duplicate pair.
 #[test]
 fn a_drifting_drive_is_explained_as_well_as_an_exact_one() {
     use polyscene::internals::Rng;
