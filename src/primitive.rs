@@ -320,14 +320,16 @@ impl Shaped {
 const DOME_EXPLAINED: f64 = 0.5;
 const DOME_SLOPE: f64 = 0.176_326_980_708_464_98;
 /// The cosines of 15 and 75 degrees: a plane seen from below and tilted
-/// between them from level is a slant cut through a crown's underside
-/// ([`Shaped::domed`]).
+/// between them from level is a slant cut through a crown's underside, and
+/// one within 15 degrees of level above the sensor is seen from below
+/// whichever way its fit leans ([`Shaped::domed`]).
 const SLANT_COS: (f64, f64) = (0.965_925_826_289_068_3, 0.258_819_045_102_520_8);
 
 impl Shaped {
     /// Is this a dome seen from below (a tree crown's underside), not a
-    /// surface? Its normal, turned towards the sensor, points down, its points
-    /// lie above the sensor on average, and either the plane is slanted
+    /// surface? Its normal, turned towards the sensor, points down or lies
+    /// within 15 degrees of vertical, its points lie above the sensor on
+    /// average, and either the plane is slanted
     /// (tilted between 15 and 75 degrees from level, [`SLANT_COS`]) or its
     /// points bend: a quadric about their centre (the distance off the plane
     /// as `a x^2 + b x y + c y^2` plus a constant) explains more than half of
@@ -339,12 +341,18 @@ impl Shaped {
     /// below is level (a ceiling, an awning) or upright (a wall's overhang).
     /// A slant cut through what the pool gathers of a crown's underside over
     /// many scans need not bend the way a quadric explains. A car's body,
-    /// which bends as much, is seen from above or from the side. `origin` and
+    /// which bends as much, is seen from above or from the side. Seen from
+    /// nearly level (the points a few degrees above the sensor), a plane
+    /// fitted through a crown's underside can lean more than the line of
+    /// sight, so that its face towards the sensor points up; a plane that
+    /// near level above the sensor is seen from below all the same (on the
+    /// own simulator's drives such a cut, 1.5-2.2 m^2 at 2 m, passed as a
+    /// surface). `origin` and
     /// `pts` are what [`shape`] was given; large supports are judged on an
     /// even-strided subsample of 20,000 points.
     pub fn domed(&self, origin: DVec3, pts: &[Vec3], viewpoint: DVec3) -> bool {
         let f = &self.primitive.frame;
-        if f.normal.z >= 0.0 {
+        if (0.0..SLANT_COS.0).contains(&f.normal.z) {
             return false;
         }
         let step = pts.len().div_ceil(20_000).max(1);
@@ -728,6 +736,26 @@ mod tests {
         assert!(judge(&tilted(30.0), below), "a slant");
         assert!(!judge(&tilted(10.0), below), "an awning");
         assert!(!judge(&tilted(88.0), below), "upright");
+        // Seen from nearly level (6 m away, 0.1 m below the points' mean
+        // height), with the points dipping 8 degrees towards the sensor:
+        // the plane's face towards the sensor points up, yet the sensor
+        // sees the crown from below, as it does the flat patch.
+        let dipped = |radius: Option<f64>| -> Vec<Vec3> {
+            let (s, c) = 8f64.to_radians().sin_cos();
+            underside(radius)
+                .iter()
+                .map(|q| {
+                    let (x, z) = (f64::from(q.x), f64::from(q.z) - 2.5);
+                    Vec3::new((x * c + z * s) as f32, q.y, (2.5 - x * s + z * c) as f32)
+                })
+                .collect()
+        };
+        let level = DVec3::new(6.0, 0.0, 2.45);
+        assert!(
+            judge(&dipped(Some(2.0)), level),
+            "a crown from nearly level"
+        );
+        assert!(!judge(&dipped(None), level), "an awning from nearly level");
     }
 
     /// Below a viewpoint, ground is judged where a surface lies: a car's

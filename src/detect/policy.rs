@@ -123,8 +123,9 @@ pub struct CascadePolicy {
     ///
     /// [`spare_crossing_surfaces`]: CascadePolicy::spare_crossing_surfaces
     pub judge_without_crossing_bands: bool,
-    /// Candidates that are domes seen from below are rejected: facing down
-    /// towards the sensor, above it on average, and bent (a quadric
+    /// Candidates that are domes seen from below are rejected: above the
+    /// sensor on average, facing down towards it or within 15 degrees of
+    /// level, and bent (a quadric
     /// explains more than half of their spread off the plane and turns by
     /// more than 20 degrees across them; `Shaped::domed`). A slab cut from
     /// a tree crown's underside passes every other test. Off in one-shot
