@@ -1277,3 +1277,68 @@ fn a_car_side_seen_a_little_in_each_scan_is_found_once_the_pool_holds_it() {
         "on the ground: found after scans {flat:?}"
     );
 }
+
+/// A scenario's first scan meets an empty map: expansion explained none of
+/// it, so its detection runs on a whole scan, and a candidate that may hold
+/// two surfaces is judged on its dominant layer, as in one-shot detection
+/// (`CascadePolicy::on_empty_map`). The scan: two roads 12 m wide crossing
+/// 1.8 m below the sensor, and a plaza a curb (15 cm) higher in each
+/// corner. A plane between the two heights holds both within the ground's
+/// inlier distance and scores more than either, but is too rough to be
+/// one surface; the whole candidate used to leave play, roads and plazas
+/// with it (measured: 5 of these 12 RANSAC seeds). On the independent
+/// bench's drifting drives a first scan kept such a plane tilted across a
+/// curb, and the map a duplicate pair. At every seed both come out, each
+/// at its own height over its own area.
+#[test]
+fn a_first_scan_keeps_roads_and_plazas_a_step_above_them() {
+    use polyscene::internals::Rng;
+    let (half, road) = (20.0, 6.0);
+    let mut rng = Rng::new(8);
+    let mut pts = Vec::new();
+    let mut u: f64 = -half;
+    while u <= half {
+        let mut v: f64 = -half;
+        while v <= half {
+            let z = if u.abs() <= road || v.abs() <= road {
+                0.0
+            } else {
+                0.15
+            };
+            pts.push(DVec3::new(u, v, z - 1.8 + 0.002 * rng.gaussian()));
+            v += 0.1;
+        }
+        u += 0.1;
+    }
+    let scan = common::flat(&pts);
+    for seed in 1..=12 {
+        let mut s = Scenario::new(Params {
+            seed,
+            ..Params::gpp2()
+        })
+        .unwrap();
+        s.add_scan(&scan, 3, &DMat4::IDENTITY).unwrap();
+        // Roads: 2 x 40 x 12 - 12 x 12 m^2; plazas: 4 x 14 x 14 m^2.
+        for (name, z, want) in [("roads", -1.8, 816.0), ("plazas", -1.65, 784.0)] {
+            let at = DVec3::new(0.0, 0.0, z);
+            let area: f64 = s
+                .primitives()
+                .iter()
+                .filter(|q| {
+                    q.plane.normal.dot(DVec3::Z).abs() > 1f64.to_radians().cos()
+                        && q.plane.signed_distance(at).abs() < 0.02
+                })
+                .map(|q| q.area)
+                .sum();
+            let got: Vec<_> = s
+                .primitives()
+                .iter()
+                .map(|q| (q.plane.normal, q.plane.offset, q.area))
+                .collect();
+            assert!(
+                (0.9 * want..1.1 * want).contains(&area),
+                "seed {seed}, {name}: {area:.1} m^2 of {want}: {got:?}"
+            );
+        }
+    }
+}

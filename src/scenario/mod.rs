@@ -326,11 +326,13 @@ impl Scenario {
         report.sent_to_detection = selection.from_scan;
         report.pool_to_detection = rest.len() - selection.from_scan;
         let pts: Vec<glam::Vec3> = rest.iter().map(|&i| cloud.points[i as usize]).collect();
-        let policy = if report.pool_to_detection > 0 {
-            CascadePolicy::scenario_leftovers().pooled()
-        } else {
-            CascadePolicy::scenario_leftovers()
-        };
+        let mut policy = CascadePolicy::scenario_leftovers();
+        if report.pool_to_detection > 0 {
+            policy = policy.pooled();
+        }
+        if self.primitives.is_empty() {
+            policy = policy.on_empty_map();
+        }
         let det = Detector::new(p, policy).run_with_rng(
             &pts,
             cloud.origin,
