@@ -40,8 +40,11 @@ pub struct MergeEvent {
 ///   it) within twice the inlier distance of non-ground planes
 ///   (`Params::layer_distance`): layers closer than RANSAC tells planes
 ///   apart, such as one surface seen again through a pose a few
-///   centimetres off. Beyond the inlier distance, half of the smaller's
-///   support must lie where the larger has support too.
+///   centimetres off. Beyond the inlier distance (`groundDistance` when
+///   both are ground: a sidewalk 9 cm above the road that borders it on
+///   two sides lies within `mergeGap` of the road's outline, and is a
+///   step), half of the smaller's support must lie where the larger has
+///   support too.
 pub fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
     if a.plane.angle_to(&b.plane) > params.merge_angle.to_radians() {
         return false;
@@ -75,11 +78,12 @@ pub fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
         && b.plane.signed_distance(ca).abs() <= params.merge_distance;
     let close = ms.sqrt() <= params.merge_distance || centroids;
     let layered = !close && ms.sqrt() <= params.layer_distance();
-    // Layers farther apart than the inlier distance are one surface only
-    // where both were seen at the same place, which two real surfaces
-    // cannot be (the nearer hides the farther): a window recessed in a
-    // facade lies where the facade has no support.
-    let seen_twice = ms.sqrt() <= params.other.distance;
+    // Layers farther apart than the inlier distance (the ground's for two
+    // ground pieces) are one surface only where both were seen at the same
+    // place, which two real surfaces cannot be (the nearer hides the
+    // farther): a window recessed in a facade lies where the facade has no
+    // support.
+    let seen_twice = ms.sqrt() <= params.surface(a.ground && b.ground).distance;
     if !close && !layered {
         return false;
     }

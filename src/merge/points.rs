@@ -753,4 +753,38 @@ mod tests {
         let (prims, _, _) = two(&a, &d, &p);
         assert!(!mergeable(&prims[0], &prims[1], &p));
     }
+
+    /// Ground keeps to the ground's inlier distance (`groundDistance`,
+    /// 8 cm): a plaza or sidewalk 9 cm above the road that borders it on two
+    /// sides (its outline's corners on the road's edges) is a step, not a
+    /// layer of the road, and stays apart; a piece of road seen again 9 cm
+    /// higher through a drifting pose, over the road, still merges.
+    #[test]
+    fn ground_a_step_above_the_road_beside_it_stays_apart() {
+        let p = Params::gpp2();
+        let grid = |x: (f64, f64), y: (f64, f64), z: f64, keep: &dyn Fn(f64, f64) -> bool| {
+            let mut out = Vec::new();
+            let mut u = x.0 + 0.05;
+            while u < x.1 {
+                let mut v = y.0 + 0.05;
+                while v < y.1 {
+                    if keep(u, v) {
+                        out.push(Vec3::new(u as f32, v as f32, z as f32));
+                    }
+                    v += 0.1;
+                }
+                u += 0.1;
+            }
+            out
+        };
+        // An L of road 2 m wide around the plaza's corner.
+        let road = grid((0.0, 10.0), (0.0, 10.0), 0.0, &|u, v| u < 2.0 || v < 2.0);
+        let plaza = grid((2.0, 10.0), (2.0, 10.0), 0.09, &|_, _| true);
+        let (prims, _, _) = two(&road, &plaza, &p);
+        assert!(prims[0].ground && prims[1].ground);
+        assert!(!mergeable(&prims[0], &prims[1], &p), "a plaza 9 cm up");
+        let again = grid((0.0, 10.0), (0.0, 2.0), 0.09, &|_, _| true);
+        let (prims, _, _) = two(&road, &again, &p);
+        assert!(mergeable(&prims[0], &prims[1], &p), "the road seen again");
+    }
 }
