@@ -327,7 +327,7 @@ const SLANT_COS: (f64, f64) = (0.965_925_826_289_068_3, 0.258_819_045_102_520_8)
 
 impl Shaped {
     /// Is this a dome seen from below (a tree crown's underside), not a
-    /// surface? Its normal, turned towards the sensor, points down or lies
+    /// surface? Its normal, turned towards the sensor, points down, or up
     /// within 15 degrees of vertical, its points lie above the sensor on
     /// average, and either the plane is slanted
     /// (tilted between 15 and 75 degrees from level, [`SLANT_COS`]) or its
@@ -344,10 +344,11 @@ impl Shaped {
     /// which bends as much, is seen from above or from the side. Seen from
     /// nearly level (the points a few degrees above the sensor), a plane
     /// fitted through a crown's underside can lean more than the line of
-    /// sight, so that its face towards the sensor points up; a plane that
-    /// near level above the sensor is seen from below all the same (on the
-    /// own simulator's drives such a cut, 1.5-2.2 m^2 at 2 m, passed as a
-    /// surface). `origin` and
+    /// sight, so that its face towards the sensor points up; such a plane is
+    /// judged too, and is a dome when it bends as above with its rim higher
+    /// than its middle (on the own simulator's drives such a cut, 1.5-2.2
+    /// m^2 at 2 m, passed as a surface; a crest of ground above the sensor
+    /// bends the other way). `origin` and
     /// `pts` are what [`shape`] was given; large supports are judged on an
     /// even-strided subsample of 20,000 points.
     pub fn domed(&self, origin: DVec3, pts: &[Vec3], viewpoint: DVec3) -> bool {
@@ -407,6 +408,12 @@ impl Shaped {
         let co = xx.inverse() * xd;
         // The share of the spread the fit explains.
         if co.dot(xd) <= DOME_EXPLAINED * sdd {
+            return false;
+        }
+        // Facing up, only a bend that opens upwards (its rim higher than its
+        // middle) is a crown's underside: a crest above the sensor (ground
+        // over a rise ahead) bends the other way.
+        if f.normal.z > 0.0 && co.x + co.z <= 0.0 {
             return false;
         }
         // Its slope at each point, and the 90th percentile of that.
@@ -740,22 +747,35 @@ mod tests {
         // height), with the points dipping 8 degrees towards the sensor:
         // the plane's face towards the sensor points up, yet the sensor
         // sees the crown from below, as it does the flat patch.
-        let dipped = |radius: Option<f64>| -> Vec<Vec3> {
-            let (s, c) = 8f64.to_radians().sin_cos();
+        // `bend` 1: rim up (a crown's underside); -1: rim down (a crest).
+        let dipped = |deg: f64, radius: Option<f64>, bend: f64| -> Vec<Vec3> {
+            let (s, c) = deg.to_radians().sin_cos();
             underside(radius)
                 .iter()
                 .map(|q| {
-                    let (x, z) = (f64::from(q.x), f64::from(q.z) - 2.5);
+                    let (x, z) = (f64::from(q.x), bend * (f64::from(q.z) - 2.5));
                     Vec3::new((x * c + z * s) as f32, q.y, (2.5 - x * s + z * c) as f32)
                 })
                 .collect()
         };
         let level = DVec3::new(6.0, 0.0, 2.45);
         assert!(
-            judge(&dipped(Some(2.0)), level),
+            judge(&dipped(8.0, Some(2.0), 1.0), level),
             "a crown from nearly level"
         );
-        assert!(!judge(&dipped(None), level), "an awning from nearly level");
+        assert!(
+            !judge(&dipped(8.0, None, 1.0), level),
+            "an awning from nearly level"
+        );
+        assert!(
+            !judge(&dipped(8.0, Some(2.0), -1.0), level),
+            "a crest from nearly level"
+        );
+        // Facing up and leaning more than 15 degrees: seen from above.
+        assert!(
+            !judge(&dipped(30.0, Some(2.0), 1.0), level),
+            "a bowl facing up"
+        );
     }
 
     /// Below a viewpoint, ground is judged where a surface lies: a car's
