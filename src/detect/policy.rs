@@ -1,7 +1,8 @@
 //! Which of the cascade's rules apply: one-shot detection and the
-//! scenario's detection on each scan's leftovers differ in thirteen of them,
-//! and in one more when the scenario's pool is in play
-//! ([`CascadePolicy::pooled`]).
+//! scenario's detection on each scan's leftovers differ in fourteen of them
+//! (thirteen while the scenario's map is empty,
+//! [`CascadePolicy::on_empty_map`]), and in one more when the scenario's
+//! pool is in play ([`CascadePolicy::pooled`]).
 
 /// The rule set of one detection cascade. The parameters ([`Params`])
 /// say how much (distances, areas, budgets); the policy says which rules
@@ -305,8 +306,8 @@ impl CascadePolicy {
     /// [`CascadePolicy::scenario_leftovers`] for an input that holds
     /// points of the scenario's pool: with
     /// [`pool_support`](CascadePolicy::pool_support). A scan's own
-    /// leftovers alone (the first scan, or no pool point in play) are
-    /// judged as in the paper.
+    /// leftovers alone (no pool point in play) need `minInliers`, as in
+    /// the paper.
     pub const fn pooled(self) -> Self {
         CascadePolicy {
             pool_support: true,
@@ -315,8 +316,10 @@ impl CascadePolicy {
     }
 
     /// [`CascadePolicy::scenario_leftovers`] for a scan that meets an
-    /// empty map (the first): expansion explained none of it, so the
-    /// cascade runs on a whole scan, and a candidate that may hold two
+    /// empty map, with expansion on (normally the first scan; also the
+    /// scans after it while none found a primitive, and the first after an
+    /// empty snapshot): expansion explained none of it, so the cascade runs
+    /// on a whole scan, and a candidate that may hold two
     /// surfaces is judged on its dominant layer, as in one-shot detection
     /// ([`split_rough_layers`](CascadePolicy::split_rough_layers)).
     /// Without it such a candidate (a road and the plaza a curb above it)

@@ -42,9 +42,10 @@ pub struct MergeEvent {
 ///   apart, such as one surface seen again through a pose a few
 ///   centimetres off. Beyond the inlier distance (`groundDistance` when
 ///   both are ground: a sidewalk 9 cm above the road that borders it on
-///   two sides lies within `mergeGap` of the road's outline, and is a
-///   step), half of the smaller's support must lie where the larger has
-///   support too.
+///   two sides has most of its outline's vertices within `mergeGap` of the
+///   road's outline, and is a step; with the defaults `groundDistance`
+///   equals `mergeDistance`, so every ground layer needs this), half of
+///   the smaller's support must lie where the larger has support too.
 pub fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
     if a.plane.angle_to(&b.plane) > params.merge_angle.to_radians() {
         return false;

@@ -330,7 +330,8 @@ impl Scenario {
         if report.pool_to_detection > 0 {
             policy = policy.pooled();
         }
-        if self.primitives.is_empty() {
+        // The paper's mode without expansion keeps the paper's cascade.
+        if p.expansion && self.primitives.is_empty() {
             policy = policy.on_empty_map();
         }
         let det = Detector::new(p, policy).run_with_rng(
