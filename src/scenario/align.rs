@@ -324,7 +324,13 @@ fn kept(rot: DQuat, shift: DVec3, reach: f64) -> bool {
     shift.is_finite()
         && angle.is_finite()
         && shift.length() + angle * LEVER <= reach
-        && shift.length() + angle * DEADBAND_RANGE > DEADBAND
+        && motion(shift, angle) > DEADBAND
+}
+
+/// The most a step of `shift` and a turn of `angle` (radians) about the
+/// sensor moves a point within [`DEADBAND_RANGE`] of it (m).
+fn motion(shift: DVec3, angle: f64) -> f64 {
+    shift.length() + angle * DEADBAND_RANGE
 }
 
 /// The polygon most at odds with the rest, from the normal equations at
@@ -348,8 +354,10 @@ fn odd_one(all: &System, parts: &[(usize, System)]) -> Option<usize> {
             }
         }
         let (x, _) = constrained_solve(rest.full(), rest.g);
-        let change = DVec3::new(x[3], x[4], x[5]).length()
-            + DVec3::new(x[0], x[1], x[2]).length() / LEVER * DEADBAND_RANGE;
+        let change = motion(
+            DVec3::new(x[3], x[4], x[5]),
+            DVec3::new(x[0], x[1], x[2]).length() / LEVER,
+        );
         if change > DEADBAND && worst.is_none_or(|(w, _)| change > w) {
             worst = Some((change, *k));
         }
