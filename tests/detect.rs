@@ -1604,7 +1604,7 @@ fn drive_truth(
 #[test]
 fn roads_and_plazas_a_step_above_them_are_separate_surfaces() {
     let (half, road): (f64, f64) = (20.0, 6.0);
-    let pts = height_field([-half, half], [-half, half], 0.002, 8, |x, y| {
+    let pts = common::height_field([-half, half], [-half, half], 0.002, 8, |x, y| {
         if x.abs() <= road || y.abs() <= road {
             0.0
         } else {
@@ -1617,29 +1617,6 @@ fn roads_and_plazas_a_step_above_them_are_separate_surfaces() {
         let at = DVec3::new(0.0, 0.0, z);
         assert_area_on(&det, name, DVec3::Z, at, 0.02, [0.9 * want, 1.1 * want]);
     }
-}
-
-/// Points every 0.1 m over `x` x `y` at height `z(x, y)`, with Gaussian
-/// height noise `sigma`.
-fn height_field(
-    x: [f64; 2],
-    y: [f64; 2],
-    sigma: f64,
-    seed: u64,
-    z: impl Fn(f64, f64) -> f64,
-) -> Vec<DVec3> {
-    let mut rng = Rng::new(seed);
-    let mut pts = Vec::new();
-    let mut u = x[0];
-    while u <= x[1] {
-        let mut v = y[0];
-        while v <= y[1] {
-            pts.push(DVec3::new(u, v, z(u, v) + sigma * rng.gaussian()));
-            v += 0.1;
-        }
-        u += 0.1;
-    }
-    pts
 }
 
 /// One-shot detection with the defaults (no viewpoint), invariants checked.
@@ -1748,7 +1725,7 @@ fn a_sparse_wall_behind_dense_clutter_is_found() {
 fn a_ramp_and_the_plateau_it_climbs_to_are_found_without_a_viewpoint() {
     let slope = 8f64.to_radians();
     let (run, top) = (10.0, 10.0 * libm::tan(slope));
-    let pts = height_field([-20.0, 30.0], [0.0, 12.0], 0.005, 12, |x, _| {
+    let pts = common::height_field([-20.0, 30.0], [0.0, 12.0], 0.005, 12, |x, _| {
         if x < 0.0 {
             0.0
         } else if x < run {

@@ -1292,24 +1292,14 @@ fn a_car_side_seen_a_little_in_each_scan_is_found_once_the_pool_holds_it() {
 /// at its own height over its own area.
 #[test]
 fn a_first_scan_keeps_roads_and_plazas_a_step_above_them() {
-    use polyscene::internals::Rng;
-    let (half, road) = (20.0, 6.0);
-    let mut rng = Rng::new(8);
-    let mut pts = Vec::new();
-    let mut u: f64 = -half;
-    while u <= half {
-        let mut v: f64 = -half;
-        while v <= half {
-            let z = if u.abs() <= road || v.abs() <= road {
-                0.0
-            } else {
-                0.15
-            };
-            pts.push(DVec3::new(u, v, z - 1.8 + 0.002 * rng.gaussian()));
-            v += 0.1;
+    let (half, road): (f64, f64) = (20.0, 6.0);
+    let pts = common::height_field([-half, half], [-half, half], 0.002, 8, |x, y| {
+        if x.abs() <= road || y.abs() <= road {
+            -1.8
+        } else {
+            -1.65
         }
-        u += 0.1;
-    }
+    });
     let scan = common::flat(&pts);
     for seed in 1..=12 {
         let mut s = Scenario::new(Params {

@@ -140,3 +140,26 @@ pub fn found_of_kind(
         .filter(|s| s.eligible && scene.polygons[s.id as usize].kind == kind);
     (of_kind.clone().filter(|s| s.found).count(), of_kind.count())
 }
+
+/// Points every 0.1 m over `x` x `y` at height `z(x, y)`, with Gaussian
+/// height noise `sigma`.
+pub fn height_field(
+    x: [f64; 2],
+    y: [f64; 2],
+    sigma: f64,
+    seed: u64,
+    z: impl Fn(f64, f64) -> f64,
+) -> Vec<DVec3> {
+    let mut rng = Rng::new(seed);
+    let mut pts = Vec::new();
+    let mut u = x[0];
+    while u <= x[1] {
+        let mut v = y[0];
+        while v <= y[1] {
+            pts.push(DVec3::new(u, v, z(u, v) + sigma * rng.gaussian()));
+            v += 0.1;
+        }
+        u += 0.1;
+    }
+    pts
+}
