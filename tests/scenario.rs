@@ -404,7 +404,11 @@ fn snapshot_and_restore_mid_drive_continues_identically() {
                 b.add_scan(&s.points, 4, &s.pose).unwrap();
             }
             if k == 5 {
-                b = Scenario::from_json(&b.to_json()).unwrap();
+                let text = b.to_json();
+                b = Scenario::from_json(&text).unwrap();
+                // The binding's way, through a parsed value: the same state.
+                let value = serde_json::from_str(&text).unwrap();
+                assert_eq!(Scenario::from_json_value(value).unwrap(), b);
             }
             if k >= 6 {
                 b.add_scan(&s.points, 4, &s.pose).unwrap();
@@ -781,6 +785,9 @@ fn corrupt_snapshots_are_refused_with_a_message() {
         let msg = e.to_string();
         assert!(msg.contains("not a polyscene snapshot"), "{name}: {msg}");
         assert!(msg.contains(want), "{name}: expected '{want}' in: {msg}");
+        // A parsed value is refused alike (but for the text's position).
+        let e = Scenario::from_json_value(bad).map(|_| ()).unwrap_err();
+        assert!(msg.starts_with(&e.to_string()), "{name}: {e} against {msg}");
     }
     // The good snapshot still loads and continues like the original.
     let mut back = Scenario::from_json(&good.to_string()).unwrap();

@@ -427,13 +427,12 @@ impl Params {
         Params::gpp2().as_map().keys().cloned().collect()
     }
 
-    /// The parameters as a JSON object. (Through the JSON text: the same
-    /// serde code as snapshots, which keeps the wasm build small.)
+    /// The parameters as a JSON object.
     fn as_map(&self) -> serde_json::Map<String, serde_json::Value> {
-        serde_json::to_string(self)
-            .ok()
-            .and_then(|text| serde_json::from_str(&text).ok())
-            .unwrap_or_default()
+        match serde_json::to_value(self) {
+            Ok(serde_json::Value::Object(map)) => map,
+            _ => serde_json::Map::new(),
+        }
     }
 
     /// Parameters from an options object (the JS options): start from the

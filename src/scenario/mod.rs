@@ -588,23 +588,40 @@ impl Scenario {
                 text.len()
             )));
         }
-        let s: Scenario = serde_json::from_str(text)
+        serde_json::from_str::<Scenario>(text)
+            .map_err(|e| Error::Invalid(format!("not a polyscene snapshot: {e}")))?
+            .checked()
+    }
+
+    /// [`Scenario::from_json`] for the snapshot already parsed into a JSON
+    /// value, with the same checks. The JS binding restores this way:
+    /// `JSON.parse` reads the text, so the wasm carries no JSON parser, and
+    /// an integer field above 2^53 (a seed given in Rust) reaches it as a
+    /// float, refused as the wrong type.
+    pub fn from_json_value(value: serde_json::Value) -> Result<Self> {
+        serde_json::from_value::<Scenario>(value)
+            .map_err(|e| Error::Invalid(format!("not a polyscene snapshot: {e}")))?
+            .checked()
+    }
+
+    /// A deserialised snapshot, if it describes a state the pipeline could
+    /// have reached.
+    fn checked(self) -> Result<Self> {
+        self.params.validate()?;
+        snapshot::check(&self.primitives, self.next_id, self.scans, &self.params)
             .map_err(|e| Error::Invalid(format!("not a polyscene snapshot: {e}")))?;
-        s.params.validate()?;
-        snapshot::check(&s.primitives, s.next_id, s.scans, &s.params)
-            .map_err(|e| Error::Invalid(format!("not a polyscene snapshot: {e}")))?;
-        s.pool.validate(s.scans)?;
-        crate::cloud::check_rigid(&s.correction).map_err(|e| {
+        self.pool.validate(self.scans)?;
+        crate::cloud::check_rigid(&self.correction).map_err(|e| {
             Error::Invalid(format!(
                 "not a polyscene snapshot: its pose correction is no rigid transform: {e}"
             ))
         })?;
-        if s.correction.w_axis.truncate().abs().max_element() > crate::cloud::MAX_COORDINATE {
+        if self.correction.w_axis.truncate().abs().max_element() > crate::cloud::MAX_COORDINATE {
             return Err(Error::Invalid(format!(
                 "not a polyscene snapshot: its pose correction moves points by more than {} m",
                 crate::cloud::MAX_COORDINATE
             )));
         }
-        Ok(s)
+        Ok(self)
     }
 }

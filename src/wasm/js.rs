@@ -25,6 +25,14 @@ extern "C" {
     fn object_keys(v: &JsValue) -> Result<Array, JsValue>;
     #[wasm_bindgen(catch, js_namespace = Array, js_name = isArray)]
     fn array_is_array(v: &JsValue) -> Result<bool, JsValue>;
+    // js-sys's `JSON.parse` takes a `&str`: the text would be copied into
+    // wasm memory and back.
+    #[wasm_bindgen(catch, js_namespace = JSON, js_name = parse)]
+    fn json_parse(text: &JsValue) -> Result<JsValue, JsValue>;
+    #[wasm_bindgen(catch, js_namespace = Array, js_name = "prototype.every.call")]
+    fn array_every(array: &JsValue, test: &JsValue) -> Result<bool, JsValue>;
+    #[wasm_bindgen(thread_local_v2, js_namespace = Number, js_name = isFinite)]
+    static NUMBER_IS_FINITE: JsValue;
     // `Float32Array.prototype.set.call(view of dst, src)`: one copy from a
     // typed array into wasm memory (converting the element type), as
     // js-sys's `copy_to`, but `catch` (a detached source throws).
@@ -94,6 +102,23 @@ pub(crate) fn copy_f64(dst: &mut [f64], src: &JsValue) -> Result<(), Thrown> {
 /// revoked Proxy).
 pub(crate) fn is_array(v: &JsValue) -> Result<bool, Thrown> {
     array_is_array(v)
+}
+
+/// `JSON.parse(text)` of a JS string, left in JS.
+pub(crate) fn parse(text: &JsValue) -> Result<JsValue, Thrown> {
+    json_parse(text)
+}
+
+/// The elements of the Array `v` of length `len`, when every one is a
+/// finite number (`Number.isFinite`, which converts nothing), in two calls
+/// whatever the length; `None` when one is not.
+pub(crate) fn finite_numbers(v: &JsValue, len: usize) -> Result<Option<Vec<f64>>, Thrown> {
+    if !NUMBER_IS_FINITE.with(|test| array_every(v, test))? {
+        return Ok(None);
+    }
+    let mut out = vec![0.0; len];
+    copy_f64(&mut out, v)?;
+    Ok(Some(out))
 }
 
 /// `Object.keys(v)`: own enumerable string keys (a Proxy's `ownKeys` and

@@ -9,6 +9,7 @@ use crate::cloud::Coordinates;
 use crate::mesh;
 use crate::scenario::{Scenario, MAX_SNAPSHOT_BYTES};
 use js_sys::{Array, JsString, Object, Uint32Array};
+use serde_json::Value;
 use std::cell::{Ref, RefCell, RefMut};
 use wasm_bindgen::prelude::*;
 use wasm_bindgen::JsCast;
@@ -185,6 +186,9 @@ impl JsScenario {
     /// `JSON.parse`) or `toJSONString()` output (a string). Throws when it is
     /// not a valid snapshot (see `Scenario::from_json` in the Rust docs for
     /// what is checked) or its JSON text is longer than 2^28 characters.
+    /// The text is read by `JSON.parse` (an object is first written by
+    /// `JSON.stringify`, as `JSON.stringify(scenario)` would), so a seed
+    /// above 2^53, which only Rust can give, is refused.
     #[wasm_bindgen(js_name = fromJSON)]
     pub fn from_json(
         #[wasm_bindgen(unchecked_param_type = "ScenarioSnapshot | string")] snapshot: JsValue,
@@ -205,9 +209,8 @@ impl JsScenario {
             ))
             .into());
         };
-        // The length is checked before the text is copied into wasm memory.
-        let text = match json.dyn_ref::<JsString>().filter(|_| json.is_string()) {
-            Some(s) if s.length() as usize <= MAX_SNAPSHOT_BYTES => json.as_string(),
+        match json.dyn_ref::<JsString>().filter(|_| json.is_string()) {
+            Some(s) if s.length() as usize <= MAX_SNAPSHOT_BYTES => {}
             Some(s) => {
                 return Err(invalid(format!(
                     "not a polyscene snapshot: its JSON text has {} characters, more than the \
@@ -216,11 +219,33 @@ impl JsScenario {
                 ))
                 .into())
             }
-            None => None,
-        };
-        let text =
-            text.ok_or_else(|| invalid("not a polyscene snapshot: it cannot be turned into JSON"))?;
-        Ok(JsScenario::of(Scenario::from_json(&text)?))
+            None => {
+                return Err(
+                    invalid("not a polyscene snapshot: it cannot be turned into JSON").into(),
+                )
+            }
+        }
+        // Counted in a copy of the text before `JSON.parse` builds them in
+        // JS: every value but the first follows a ',', '[' or ':' (an upper
+        // bound: a string may hold them too).
+        let values = json.as_string().map_or(0, |text| {
+            1 + text
+                .bytes()
+                .filter(|b| matches!(b, b',' | b'[' | b':'))
+                .count()
+        });
+        if values > MAX_SNAPSHOT_VALUES {
+            return Err(invalid(format!(
+                "not a polyscene snapshot: it holds more than the {MAX_SNAPSHOT_VALUES} values \
+                 (numbers, strings, arrays, objects) a snapshot may have"
+            ))
+            .into());
+        }
+        let parsed = js::parse(&json)
+            .map_err(|e| Failure::thrown("not a polyscene snapshot: JSON.parse of it", e))?;
+        let value = parsed_json(&parsed, 0)
+            .map_err(|e| invalid(format!("not a polyscene snapshot: {e}")))?;
+        Ok(JsScenario::of(Scenario::from_json_value(value)?))
     }
 
     /// Release the wasm memory now. Later calls on this object throw an
@@ -229,5 +254,75 @@ impl JsScenario {
     pub fn release(&self) -> WasmResult<()> {
         *self.inner.try_borrow_mut().map_err(|_| busy())? = None;
         Ok(())
+    }
+}
+
+/// Deepest nesting [`parsed_json`] follows (a snapshot's is 5).
+const MAX_DEPTH: u32 = 32;
+
+/// Most values (numbers, strings, arrays, objects) a snapshot may hold:
+/// `JSON.parse` builds them all in JS, and each becomes a JSON value of up
+/// to 24 bytes in wasm memory (a 10,000-scan drive's snapshot holds about
+/// 6 million).
+const MAX_SNAPSHOT_VALUES: usize = 1 << 24;
+
+/// What `JSON.parse` returned, as a JSON value: plain data, so reading it
+/// runs no user code. A number stays the double JS holds (so `toJSONString`
+/// output restores exactly, the sign of zeros included); an integer up to
+/// 2^53 becomes an integer, as serde would read it from the text.
+fn parsed_json(v: &JsValue, depth: u32) -> Result<Value, String> {
+    if depth > MAX_DEPTH {
+        return Err(format!("nested more than {MAX_DEPTH} deep"));
+    }
+    if let Some(x) = v.as_f64() {
+        return Ok(number(x));
+    }
+    if let Some(b) = v.as_bool() {
+        return Ok(Value::Bool(b));
+    }
+    if let Some(s) = v.as_string() {
+        return Ok(Value::String(s));
+    }
+    let thrown = |e: JsValue| format!("reading it threw {}", describe(&e));
+    if js::is_array(v).map_err(thrown)? {
+        let n = js::get(v, "length")
+            .map_err(thrown)?
+            .as_f64()
+            .unwrap_or(0.0) as u32;
+        // Most of a snapshot is arrays of numbers: those cross in bulk.
+        if let Some(xs) = js::finite_numbers(v, n as usize).map_err(thrown)? {
+            return Ok(Value::Array(xs.into_iter().map(number).collect()));
+        }
+        let mut out = Vec::with_capacity(n as usize);
+        for i in 0..n {
+            out.push(parsed_json(
+                &js::get_index(v, i).map_err(thrown)?,
+                depth + 1,
+            )?);
+        }
+        return Ok(Value::Array(out));
+    }
+    if v.is_object() {
+        let mut out = serde_json::Map::new();
+        for key in js::keys(v).map_err(thrown)? {
+            let item = js::get_key(v, &key).map_err(thrown)?;
+            out.insert(
+                key.as_string().unwrap_or_default(),
+                parsed_json(&item, depth + 1)?,
+            );
+        }
+        return Ok(Value::Object(out));
+    }
+    Ok(Value::Null)
+}
+
+/// A JS number as JSON: an integer when it is one up to 2^53, as serde
+/// reads one from the text (but for -0, which stays the double -0).
+fn number(x: f64) -> Value {
+    let int = x.fract() == 0.0 && x.abs() <= MAX_SAFE_INTEGER && x.to_bits() != (-0.0f64).to_bits();
+    match int {
+        true if x >= 0.0 => Value::from(x as u64),
+        true => Value::from(x as i64),
+        false => Value::from(x),
     }
 }

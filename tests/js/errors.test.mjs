@@ -161,6 +161,8 @@ test("bad snapshots", () => {
     [{ params: {}, primitives: [{}], nextId: 0, scans: 0 }, /not a polyscene snapshot/, /missing field/],
     [{ params: {}, primitives: [], nextId: 0, scans: 0, extra: 1 }, null],
     [{ params: {}, primitives: [], nextId: 0, scans: 0, big: 10n }, /not a polyscene snapshot/],
+    // JSON.parse takes this nesting; reading it into wasm stops at 32.
+    [`{"params": {}, "primitives": [], "nextId": 0, "scans": 0, "extra": ${"[".repeat(5000)}${"]".repeat(5000)}}`, /not a polyscene snapshot/, /nested more than 32 deep/],
   ];
   for (const [snap, ...patterns] of cases) {
     if (patterns[0] === null) {
@@ -169,6 +171,13 @@ test("bad snapshots", () => {
     }
     throwsError(assert, () => ps.Scenario.fromJSON(snap), ...patterns);
   }
+  // A seed above 2^53 (only Rust can give one) is refused, not rounded by JSON.parse.
+  const fresh = new ps.Scenario();
+  const plain = fresh.toJSONString();
+  fresh.free();
+  const huge = plain.replace(/"seed":\d+/, '"seed":18446744073709551615');
+  assert.notEqual(huge, plain);
+  throwsError(assert, () => ps.Scenario.fromJSON(huge), /not a polyscene snapshot/, /expected u64/);
   // A real snapshot with a corrupted footprint grid is refused, not trapped on later.
   const s = new ps.Scenario();
   s.addScan(floor(), { pose: [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -5, -5, -1.8, 1] });
@@ -254,6 +263,9 @@ test("defaultOptions refuses non-strings; huge inputs are refused before they ar
   big.length = 2 ** 32 - 1;
   throwsError(assert, () => ps.detect(big), /points/, /more than/);
   throwsError(assert, () => ps.Scenario.fromJSON("x".repeat(2 ** 28 + 1)), /not a polyscene snapshot/, /268435456/);
+  // 2^24 values at most, counted before JSON.parse builds them.
+  const many = `{"params": {}, "primitives": [], "nextId": 0, "scans": 0, "extra": [${"0,".repeat(2 ** 24)}0]}`;
+  throwsError(assert, () => ps.Scenario.fromJSON(many), /not a polyscene snapshot/, /16777216 values/);
   stillWorks();
 });
 

@@ -55,6 +55,7 @@ test("toJSON() and toJSONString() restore the same state", () => {
   const fromObject = ps.Scenario.fromJSON(JSON.parse(JSON.stringify(s.toJSON())));
   const fromString = ps.Scenario.fromJSON(s.toJSONString());
   // The string is exact; the object loses only the sign of zeros (JSON.stringify(-0) is "0").
+  assert.match(s.toJSONString(), /[[,:]-0\.0[,\]}]/, "the snapshot holds a negative zero");
   assert.equal(fromString.toJSONString(), s.toJSONString());
   const normalised = (x) => JSON.stringify(JSON.parse(x.toJSONString()));
   assert.equal(normalised(fromObject), normalised(s));
