@@ -789,6 +789,14 @@ fn corrupt_snapshots_are_refused_with_a_message() {
         let e = Scenario::from_json_value(bad).map(|_| ()).unwrap_err();
         assert!(msg.starts_with(&e.to_string()), "{name}: {e} against {msg}");
     }
+    // A scenario never has a viewpoint (its scans' poses place the
+    // sensor): a snapshot with one is refused as `Scenario::new` refuses it.
+    let mut seen_from = good.clone();
+    seen_from["params"]["viewpoint"] = json!([0.0, 0.0, 1.8]);
+    let e = Scenario::from_json(&seen_from.to_string())
+        .map(|_| ())
+        .unwrap_err();
+    assert!(e.to_string().contains("'viewpoint'"), "{e}");
     // The good snapshot still loads and continues like the original.
     let mut back = Scenario::from_json(&good.to_string()).unwrap();
     let scan = drive(Layout::Crossing, DVec3::ZERO).scan(6).unwrap();

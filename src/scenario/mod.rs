@@ -163,15 +163,7 @@ impl Scenario {
     /// An empty scenario. Errors on invalid parameters, and on a
     /// `viewpoint`: each scan's sensor position comes from its pose.
     pub fn new(params: Params) -> Result<Self> {
-        params.validate()?;
-        if params.viewpoint.is_some() {
-            return Err(Error::BadOption {
-                key: "viewpoint".into(),
-                reason: "a scenario takes each scan's sensor position from its pose; \
-                         viewpoint is for one-shot detection"
-                    .into(),
-            });
-        }
+        check_params(&params)?;
         Ok(Scenario {
             params,
             primitives: Vec::new(),
@@ -607,7 +599,7 @@ impl Scenario {
     /// A deserialised snapshot, if it describes a state the pipeline could
     /// have reached.
     fn checked(self) -> Result<Self> {
-        self.params.validate()?;
+        check_params(&self.params)?;
         snapshot::check(&self.primitives, self.next_id, self.scans, &self.params)
             .map_err(|e| Error::Invalid(format!("not a polyscene snapshot: {e}")))?;
         self.pool.validate(self.scans)?;
@@ -624,4 +616,19 @@ impl Scenario {
         }
         Ok(self)
     }
+}
+
+/// Parameters a scenario can run with: valid, and without a `viewpoint`
+/// (each scan's sensor position comes from its pose).
+fn check_params(params: &Params) -> Result<()> {
+    params.validate()?;
+    if params.viewpoint.is_some() {
+        return Err(Error::BadOption {
+            key: "viewpoint".into(),
+            reason: "a scenario takes each scan's sensor position from its pose; \
+                     viewpoint is for one-shot detection"
+                .into(),
+        });
+    }
+    Ok(())
 }
