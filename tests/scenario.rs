@@ -406,7 +406,8 @@ fn snapshot_and_restore_mid_drive_continues_identically() {
             if k == 5 {
                 let text = b.to_json();
                 b = Scenario::from_json(&text).unwrap();
-                // The binding's way, through a parsed value: the same state.
+                // Through a parsed value (as the binding restores, but
+                // parsed by serde here): the same state.
                 let value = serde_json::from_str(&text).unwrap();
                 assert_eq!(Scenario::from_json_value(value).unwrap(), b);
             }

@@ -588,8 +588,8 @@ impl Scenario {
     /// [`Scenario::from_json`] for the snapshot already parsed into a JSON
     /// value, with the same checks. The JS binding restores this way:
     /// `JSON.parse` reads the text, so the wasm carries no JSON parser, and
-    /// an integer field above 2^53 (a seed given in Rust) reaches it as a
-    /// float, refused as the wrong type.
+    /// an integer field of 2^53 or more (a `seed` or `maxWork` given in
+    /// Rust) reaches it as a float, refused as the wrong type.
     pub fn from_json_value(value: serde_json::Value) -> Result<Self> {
         serde_json::from_value::<Scenario>(value)
             .map_err(|e| Error::Invalid(format!("not a polyscene snapshot: {e}")))?

@@ -164,8 +164,9 @@ impl JsScenario {
             for (key, v) in [("seed", p.seed), ("maxWork", p.max_work)] {
                 if v as f64 > MAX_SAFE_INTEGER {
                     return Err(invalid(format!(
-                        "snapshot: option '{key}' is {v}, above 2^53, which a JS number cannot \
-                         hold exactly; use toJSONString()"
+                        "snapshot: option '{key}' is {v}, 2^53 or more, which a JS number \
+                         cannot hold exactly; toJSONString() keeps it, for Scenario::from_json \
+                         in Rust (fromJSON refuses it)"
                     ))
                     .into());
                 }
@@ -187,8 +188,10 @@ impl JsScenario {
     /// not a valid snapshot (see `Scenario::from_json` in the Rust docs for
     /// what is checked) or its JSON text is longer than 2^28 characters.
     /// The text is read by `JSON.parse` (an object is first written by
-    /// `JSON.stringify`, as `JSON.stringify(scenario)` would), so a seed
-    /// above 2^53, which only Rust can give, is refused.
+    /// `JSON.stringify`, as `JSON.stringify(scenario)` would), so a `seed`
+    /// or `maxWork` of 2^53 or more, which only Rust can give, is refused.
+    /// A little laxer than `Scenario::from_json` in Rust: an integer may be
+    /// written as a float (`1.0`), and of two equal keys the last counts.
     #[wasm_bindgen(js_name = fromJSON)]
     pub fn from_json(
         #[wasm_bindgen(unchecked_param_type = "ScenarioSnapshot | string")] snapshot: JsValue,
@@ -226,18 +229,21 @@ impl JsScenario {
             }
         }
         // Counted in a copy of the text before `JSON.parse` builds them in
-        // JS: every value but the first follows a ',', '[' or ':' (an upper
-        // bound: a string may hold them too).
-        let values = json.as_string().map_or(0, |text| {
-            1 + text
-                .bytes()
-                .filter(|b| matches!(b, b',' | b'[' | b':'))
-                .count()
-        });
-        if values > MAX_SNAPSHOT_VALUES {
+        // JS: every value but the first follows a ',', '[' or ':', every
+        // object starts at a '{' (upper bounds: a string may hold them too).
+        let (mut values, mut objects) = (1, 0);
+        for b in json.as_string().unwrap_or_default().bytes() {
+            match b {
+                b',' | b'[' | b':' => values += 1,
+                b'{' => objects += 1,
+                _ => {}
+            }
+        }
+        if values > MAX_SNAPSHOT_VALUES || objects > MAX_SNAPSHOT_OBJECTS {
             return Err(invalid(format!(
                 "not a polyscene snapshot: it holds more than the {MAX_SNAPSHOT_VALUES} values \
-                 (numbers, strings, arrays, objects) a snapshot may have"
+                 (numbers, strings, arrays, objects) or {MAX_SNAPSHOT_OBJECTS} objects a \
+                 snapshot may have"
             ))
             .into());
         }
@@ -261,21 +267,26 @@ impl JsScenario {
 const MAX_DEPTH: u32 = 32;
 
 /// Most values (numbers, strings, arrays, objects) a snapshot may hold:
-/// `JSON.parse` builds them all in JS, and each becomes a JSON value of up
-/// to 24 bytes in wasm memory (a 10,000-scan drive's snapshot holds about
-/// 6 million).
+/// `JSON.parse` builds them all in JS, and each becomes a JSON value in
+/// wasm memory, 24 bytes in its array or object (a 10,000-scan drive's
+/// snapshot holds about 6 million).
 const MAX_SNAPSHOT_VALUES: usize = 1 << 24;
+
+/// Most objects a snapshot may hold: each costs some 450 bytes of wasm
+/// memory as a JSON object (a snapshot holds about five a polygon; the
+/// 2^28 characters of text hold at most some 350,000 in a real one).
+const MAX_SNAPSHOT_OBJECTS: usize = 1 << 19;
 
 /// What `JSON.parse` returned, as a JSON value: plain data, so reading it
 /// runs no user code. A number stays the double JS holds (so `toJSONString`
-/// output restores exactly, the sign of zeros included); an integer up to
-/// 2^53 becomes an integer, as serde would read it from the text.
+/// output restores exactly, the sign of zeros included), as an integer when
+/// it is one below 2^53 (so that integer fields read it).
 fn parsed_json(v: &JsValue, depth: u32) -> Result<Value, String> {
     if depth > MAX_DEPTH {
         return Err(format!("nested more than {MAX_DEPTH} deep"));
     }
     if let Some(x) = v.as_f64() {
-        return Ok(number(x));
+        return number(x);
     }
     if let Some(b) = v.as_bool() {
         return Ok(Value::Bool(b));
@@ -291,7 +302,11 @@ fn parsed_json(v: &JsValue, depth: u32) -> Result<Value, String> {
             .unwrap_or(0.0) as u32;
         // Most of a snapshot is arrays of numbers: those cross in bulk.
         if let Some(xs) = js::finite_numbers(v, n as usize).map_err(thrown)? {
-            return Ok(Value::Array(xs.into_iter().map(number).collect()));
+            return xs
+                .into_iter()
+                .map(number)
+                .collect::<Result<_, _>>()
+                .map(Value::Array);
         }
         let mut out = Vec::with_capacity(n as usize);
         for i in 0..n {
@@ -316,13 +331,19 @@ fn parsed_json(v: &JsValue, depth: u32) -> Result<Value, String> {
     Ok(Value::Null)
 }
 
-/// A JS number as JSON: an integer when it is one up to 2^53, as serde
-/// reads one from the text (but for -0, which stays the double -0).
-fn number(x: f64) -> Value {
+/// A JS number as JSON: an integer when it is one below 2^53 (but for -0,
+/// which stays the double -0), else the double. Refused when not finite
+/// (`JSON.parse` reads `1e999` as Infinity), as serde refuses it in text.
+fn number(x: f64) -> Result<Value, String> {
+    if !x.is_finite() {
+        return Err(
+            "a number is out of range (JSON.parse reads one beyond 1.8e308 as Infinity)".into(),
+        );
+    }
     let int = x.fract() == 0.0 && x.abs() <= MAX_SAFE_INTEGER && x.to_bits() != (-0.0f64).to_bits();
-    match int {
+    Ok(match int {
         true if x >= 0.0 => Value::from(x as u64),
         true => Value::from(x as i64),
         false => Value::from(x),
-    }
+    })
 }

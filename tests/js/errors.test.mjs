@@ -178,6 +178,10 @@ test("bad snapshots", () => {
   const huge = plain.replace(/"seed":\d+/, '"seed":18446744073709551615');
   assert.notEqual(huge, plain);
   throwsError(assert, () => ps.Scenario.fromJSON(huge), /not a polyscene snapshot/, /expected u64/);
+  // A number beyond a double's range is refused (JSON.parse reads it as Infinity), not read as null.
+  const infinite = plain.replace('"viewpoint":null', '"viewpoint":1e999');
+  assert.notEqual(infinite, plain);
+  throwsError(assert, () => ps.Scenario.fromJSON(infinite), /not a polyscene snapshot/, /out of range/, /Infinity/);
   // A real snapshot with a corrupted footprint grid is refused, not trapped on later.
   const s = new ps.Scenario();
   s.addScan(floor(), { pose: [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, -5, -5, -1.8, 1] });
@@ -263,6 +267,10 @@ test("defaultOptions refuses non-strings; huge inputs are refused before they ar
   big.length = 2 ** 32 - 1;
   throwsError(assert, () => ps.detect(big), /points/, /more than/);
   throwsError(assert, () => ps.Scenario.fromJSON("x".repeat(2 ** 28 + 1)), /not a polyscene snapshot/, /268435456/);
+  // 2^19 objects at most (the root and its params are two), counted before JSON.parse builds them.
+  const objects = (n) => `{"params": {}, "primitives": [], "nextId": 0, "scans": 0, "extra": [${"{},".repeat(n - 3)}{}]}`;
+  ps.Scenario.fromJSON(objects(2 ** 19)).free();
+  throwsError(assert, () => ps.Scenario.fromJSON(objects(2 ** 19 + 1)), /not a polyscene snapshot/, /524288 objects/);
   // 2^24 values at most, counted before JSON.parse builds them.
   const many = `{"params": {}, "primitives": [], "nextId": 0, "scans": 0, "extra": [${"0,".repeat(2 ** 24)}0]}`;
   throwsError(assert, () => ps.Scenario.fromJSON(many), /not a polyscene snapshot/, /16777216 values/);
