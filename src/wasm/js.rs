@@ -26,11 +26,15 @@ extern "C" {
     #[wasm_bindgen(catch, js_namespace = Array, js_name = isArray)]
     fn array_is_array(v: &JsValue) -> Result<bool, JsValue>;
     // js-sys's `JSON.parse` takes a `&str`: the text would be copied into
-    // wasm memory and back.
+    // wasm memory and back. (These three serve snapshots, which only the
+    // detection binding restores.)
+    #[cfg(feature = "wasm-main")]
     #[wasm_bindgen(catch, js_namespace = JSON, js_name = parse)]
     fn json_parse(text: &JsValue) -> Result<JsValue, JsValue>;
+    #[cfg(feature = "wasm-main")]
     #[wasm_bindgen(catch, js_namespace = Array, js_name = "prototype.every.call")]
     fn array_every(array: &JsValue, test: &JsValue) -> Result<bool, JsValue>;
+    #[cfg(feature = "wasm-main")]
     #[wasm_bindgen(thread_local_v2, js_namespace = Number, js_name = isFinite)]
     static NUMBER_IS_FINITE: JsValue;
     // `Float32Array.prototype.set.call(view of dst, src)`: one copy from a
@@ -105,6 +109,7 @@ pub(crate) fn is_array(v: &JsValue) -> Result<bool, Thrown> {
 }
 
 /// `JSON.parse(text)` of a JS string, left in JS.
+#[cfg(feature = "wasm-main")]
 pub(crate) fn parse(text: &JsValue) -> Result<JsValue, Thrown> {
     json_parse(text)
 }
@@ -112,6 +117,7 @@ pub(crate) fn parse(text: &JsValue) -> Result<JsValue, Thrown> {
 /// The elements of the Array `v` of length `len`, when every one is a
 /// finite number (`Number.isFinite`, which converts nothing), in two calls
 /// whatever the length; `None` when one is not.
+#[cfg(feature = "wasm-main")]
 pub(crate) fn finite_numbers(v: &JsValue, len: usize) -> Result<Option<Vec<f64>>, Thrown> {
     if !NUMBER_IS_FINITE.with(|test| array_every(v, test))? {
         return Ok(None);
