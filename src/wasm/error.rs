@@ -27,11 +27,27 @@ pub struct Failure {
     cause: Option<JsValue>,
 }
 
+/// Longest message a failure carries (bytes). A longer one is cut: serde's
+/// messages quote the value they refuse, and a hostile snapshot's string of
+/// 2^28 characters, quoted, is longer than V8 lets a string be.
+const MAX_MESSAGE: usize = 4000;
+
 impl Failure {
-    /// A failure with this message and no cause.
+    /// A failure with this message (cut after [`MAX_MESSAGE`] bytes) and no
+    /// cause.
     pub(crate) fn new(message: impl Into<String>) -> Failure {
+        let mut message = message.into();
+        if message.len() > MAX_MESSAGE {
+            let mut end = MAX_MESSAGE;
+            while !message.is_char_boundary(end) {
+                end -= 1;
+            }
+            let all = message.len();
+            message.truncate(end);
+            message += &format!("... (cut: {all} bytes in all)");
+        }
         Failure {
-            message: message.into(),
+            message,
             cause: None,
         }
     }
@@ -49,8 +65,8 @@ impl Failure {
     /// A failure with this message, caused by the thrown `value`.
     pub(crate) fn caused(message: impl Into<String>, value: JsValue) -> Failure {
         Failure {
-            message: message.into(),
             cause: Some(value),
+            ..Failure::new(message)
         }
     }
 

@@ -239,13 +239,21 @@ impl JsScenario {
                 _ => {}
             }
         }
-        if values > MAX_SNAPSHOT_VALUES || objects > MAX_SNAPSHOT_OBJECTS {
-            return Err(invalid(format!(
-                "not a polyscene snapshot: it holds more than the {MAX_SNAPSHOT_VALUES} values \
-                 (numbers, strings, arrays, objects) or {MAX_SNAPSHOT_OBJECTS} objects a \
-                 snapshot may have"
-            ))
-            .into());
+        for (count, most, what) in [
+            (
+                values,
+                MAX_SNAPSHOT_VALUES,
+                "values (numbers, strings, arrays, objects)",
+            ),
+            (objects, MAX_SNAPSHOT_OBJECTS, "objects"),
+        ] {
+            if count > most {
+                return Err(invalid(format!(
+                    "not a polyscene snapshot: it holds more than the {most} {what} a snapshot \
+                     may have"
+                ))
+                .into());
+            }
         }
         let parsed = js::parse(&json)
             .map_err(|e| Failure::thrown("not a polyscene snapshot: JSON.parse of it", e))?;
@@ -268,14 +276,16 @@ const MAX_DEPTH: u32 = 32;
 
 /// Most values (numbers, strings, arrays, objects) a snapshot may hold:
 /// `JSON.parse` builds them all in JS, and each becomes a JSON value in
-/// wasm memory, 24 bytes in its array or object (a 10,000-scan drive's
-/// snapshot holds about 6 million).
+/// wasm memory: 24 bytes in its array or object, and an array's own list,
+/// an object's map, a string's characters (a 10,000-scan drive's snapshot
+/// holds about 6 million).
 const MAX_SNAPSHOT_VALUES: usize = 1 << 24;
 
-/// Most objects a snapshot may hold: each costs some 450 bytes of wasm
-/// memory as a JSON object (a snapshot holds about five a polygon; the
-/// 2^28 characters of text hold at most some 350,000 in a real one).
-const MAX_SNAPSHOT_OBJECTS: usize = 1 << 19;
+/// Most objects a snapshot may hold: a JSON object with members takes
+/// some 450 bytes of wasm memory (a snapshot holds five a polygon and
+/// about 1-2 kB of text per polygon, so this refuses one of more than
+/// about 200,000 polygons; a 10,000-scan drive's holds 15,000).
+const MAX_SNAPSHOT_OBJECTS: usize = 1 << 20;
 
 /// What `JSON.parse` returned, as a JSON value: plain data, so reading it
 /// runs no user code. A number stays the double JS holds (so `toJSONString`
@@ -292,7 +302,7 @@ fn parsed_json(v: &JsValue, depth: u32) -> Result<Value, String> {
         return Ok(Value::Bool(b));
     }
     if let Some(s) = v.as_string() {
-        return Ok(Value::String(s));
+        return printable(s).map(Value::String);
     }
     let thrown = |e: JsValue| format!("reading it threw {}", describe(&e));
     if js::is_array(v).map_err(thrown)? {
@@ -302,11 +312,11 @@ fn parsed_json(v: &JsValue, depth: u32) -> Result<Value, String> {
             .unwrap_or(0.0) as u32;
         // Most of a snapshot is arrays of numbers: those cross in bulk.
         if let Some(xs) = js::finite_numbers(v, n as usize).map_err(thrown)? {
-            return xs
-                .into_iter()
-                .map(number)
-                .collect::<Result<_, _>>()
-                .map(Value::Array);
+            let mut out = Vec::with_capacity(xs.len());
+            for x in xs {
+                out.push(number(x)?);
+            }
+            return Ok(Value::Array(out));
         }
         let mut out = Vec::with_capacity(n as usize);
         for i in 0..n {
@@ -322,13 +332,25 @@ fn parsed_json(v: &JsValue, depth: u32) -> Result<Value, String> {
         for key in js::keys(v).map_err(thrown)? {
             let item = js::get_key(v, &key).map_err(thrown)?;
             out.insert(
-                key.as_string().unwrap_or_default(),
+                printable(key.as_string().unwrap_or_default())?,
                 parsed_json(&item, depth + 1)?,
             );
         }
         return Ok(Value::Object(out));
     }
     Ok(Value::Null)
+}
+
+/// A snapshot's string (hex digits, option names and values): refused
+/// unless printable ASCII. serde's messages quote a string of the wrong
+/// type escaped, up to ten bytes a character, which for one of 2^28
+/// characters outgrew what wasm memory can hold.
+fn printable(s: String) -> Result<String, String> {
+    if s.bytes().all(|b| (b' '..=b'~').contains(&b)) {
+        Ok(s)
+    } else {
+        Err("a string holds a character other than printable ASCII".into())
+    }
 }
 
 /// A JS number as JSON: an integer when it is one below 2^53 (but for -0,

@@ -178,6 +178,14 @@ test("bad snapshots", () => {
   const huge = plain.replace(/"seed":\d+/, '"seed":18446744073709551615');
   assert.notEqual(huge, plain);
   throwsError(assert, () => ps.Scenario.fromJSON(huge), /not a polyscene snapshot/, /expected u64/);
+  // A snapshot's strings are printable ASCII; a message quoting a long one is cut.
+  const accented = plain.replace('"hull":"concave"', '"hull":"concav\u00e9"');
+  assert.notEqual(accented, plain);
+  throwsError(assert, () => ps.Scenario.fromJSON(accented), /not a polyscene snapshot/, /printable ASCII/);
+  const long = plain.replace('"nextId":0', `"nextId":"${"a".repeat(100000)}"`);
+  assert.notEqual(long, plain);
+  const cut = throwsError(assert, () => ps.Scenario.fromJSON(long), /not a polyscene snapshot/, /invalid type: string/, /cut: \d+ bytes in all/);
+  assert.ok(cut.message.length < 4100, `${cut.message.length} characters`);
   // A number beyond a double's range is refused (JSON.parse reads it as Infinity), not read as null.
   const infinite = plain.replace('"viewpoint":null', '"viewpoint":1e999');
   assert.notEqual(infinite, plain);
@@ -267,13 +275,13 @@ test("defaultOptions refuses non-strings; huge inputs are refused before they ar
   big.length = 2 ** 32 - 1;
   throwsError(assert, () => ps.detect(big), /points/, /more than/);
   throwsError(assert, () => ps.Scenario.fromJSON("x".repeat(2 ** 28 + 1)), /not a polyscene snapshot/, /268435456/);
-  // 2^19 objects at most (the root and its params are two), counted before JSON.parse builds them.
+  // 2^20 objects at most (the root and its params are two), counted before JSON.parse builds them.
   const objects = (n) => `{"params": {}, "primitives": [], "nextId": 0, "scans": 0, "extra": [${"{},".repeat(n - 3)}{}]}`;
-  ps.Scenario.fromJSON(objects(2 ** 19)).free();
-  throwsError(assert, () => ps.Scenario.fromJSON(objects(2 ** 19 + 1)), /not a polyscene snapshot/, /524288 objects/);
+  ps.Scenario.fromJSON(objects(2 ** 20)).free();
+  throwsError(assert, () => ps.Scenario.fromJSON(objects(2 ** 20 + 1)), /not a polyscene snapshot/, /more than the 1048576 objects/);
   // 2^24 values at most, counted before JSON.parse builds them.
   const many = `{"params": {}, "primitives": [], "nextId": 0, "scans": 0, "extra": [${"0,".repeat(2 ** 24)}0]}`;
-  throwsError(assert, () => ps.Scenario.fromJSON(many), /not a polyscene snapshot/, /16777216 values/);
+  throwsError(assert, () => ps.Scenario.fromJSON(many), /not a polyscene snapshot/, /more than the 16777216 values/);
   stillWorks();
 });
 
