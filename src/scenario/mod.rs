@@ -581,7 +581,7 @@ impl Scenario {
             )));
         }
         serde_json::from_str::<Scenario>(text)
-            .map_err(|e| Error::Invalid(format!("not a polyscene snapshot: {e}")))?
+            .map_err(not_a_snapshot)?
             .checked()
     }
 
@@ -592,7 +592,7 @@ impl Scenario {
     /// Rust) reaches it as a float, refused as the wrong type.
     pub fn from_json_value(value: serde_json::Value) -> Result<Self> {
         serde_json::from_value::<Scenario>(value)
-            .map_err(|e| Error::Invalid(format!("not a polyscene snapshot: {e}")))?
+            .map_err(not_a_snapshot)?
             .checked()
     }
 
@@ -616,6 +616,11 @@ impl Scenario {
         }
         Ok(self)
     }
+}
+
+/// A snapshot serde could not read.
+fn not_a_snapshot(e: serde_json::Error) -> Error {
+    Error::Invalid(format!("not a polyscene snapshot: {e}"))
 }
 
 /// Parameters a scenario can run with: valid, and without a `viewpoint`

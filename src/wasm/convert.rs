@@ -456,20 +456,23 @@ fn json_value(key: &str, v: &JsValue) -> WasmResult<Value> {
     Ok(Value::Array(out))
 }
 
-/// A finite JS number as JSON: an integer when it is one (so that integer
-/// options accept `7`), a float otherwise.
+/// A finite JS number as an option's JSON (-0 is 0: a `seed` of -0 is 0).
 fn json_number(key: &str, x: f64) -> Result<Value> {
     if !x.is_finite() {
         return Err(bad_option(key, format!("must be a finite number, got {x}")));
     }
-    if x.fract() == 0.0 && x.abs() <= MAX_SAFE_INTEGER {
-        return Ok(if x >= 0.0 {
-            Value::from(x as u64)
-        } else {
-            Value::from(x as i64)
-        });
+    Ok(finite_number(if x == 0.0 { 0.0 } else { x }))
+}
+
+/// A finite JS number as JSON: an integer when it is one below 2^53 (so
+/// that integer fields read `7`), else the double (-0 included).
+pub(super) fn finite_number(x: f64) -> Value {
+    let int = x.fract() == 0.0 && x.abs() <= MAX_SAFE_INTEGER && x.to_bits() != (-0.0f64).to_bits();
+    match int {
+        true if x >= 0.0 => Value::from(x as u64),
+        true => Value::from(x as i64),
+        false => Value::from(x),
     }
-    Ok(Value::from(x))
 }
 
 #[cfg(feature = "wasm-main")]

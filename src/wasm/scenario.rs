@@ -1,7 +1,8 @@
 //! The `Scenario` class: the live map, one scan at a time.
 
 use super::convert::{
-    mesh_object, points_of, polygons_array, to_js, ScanOptions, ScenarioOptions, MAX_SAFE_INTEGER,
+    finite_number, mesh_object, points_of, polygons_array, to_js, ScanOptions, ScenarioOptions,
+    MAX_SAFE_INTEGER,
 };
 use super::error::{invalid, Failure, WasmResult};
 use super::js::{self, describe};
@@ -353,8 +354,7 @@ fn printable(s: String) -> Result<String, String> {
     }
 }
 
-/// A JS number as JSON: an integer when it is one below 2^53 (but for -0,
-/// which stays the double -0), else the double. Refused when not finite
+/// A JS number as JSON ([`finite_number`]); refused when not finite
 /// (`JSON.parse` reads `1e999` as Infinity), as serde refuses it in text.
 fn number(x: f64) -> Result<Value, String> {
     if !x.is_finite() {
@@ -362,10 +362,5 @@ fn number(x: f64) -> Result<Value, String> {
             "a number is out of range (JSON.parse reads one beyond 1.8e308 as Infinity)".into(),
         );
     }
-    let int = x.fract() == 0.0 && x.abs() <= MAX_SAFE_INTEGER && x.to_bits() != (-0.0f64).to_bits();
-    Ok(match int {
-        true if x >= 0.0 => Value::from(x as u64),
-        true => Value::from(x as i64),
-        false => Value::from(x),
-    })
+    Ok(finite_number(x))
 }
