@@ -127,6 +127,14 @@ impl Primitive {
         s.alpha * (self.footprint.cell() / s.cell)
     }
 
+    /// Clustering tolerance of this primitive (m), scaled as
+    /// [`Primitive::alpha`] is: how far from its true edge its outline can
+    /// lie.
+    pub(crate) fn cluster_tolerance(&self, params: &Params) -> f64 {
+        let s = params.surface(self.ground);
+        s.cluster_tolerance * (self.footprint.cell() / s.cell)
+    }
+
     /// Recompute the outline after the footprint or hull points changed.
     /// `extra` are new support points (frame coordinates) for convex hulls.
     /// Returns false (leaving the primitive unchanged) when no outline exists.

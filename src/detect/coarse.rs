@@ -39,7 +39,7 @@ pub(super) const STREAM: u64 = 0xC0A5;
 /// pass's count would ask a far facade for the support of one seen face
 /// on. (Over `SCALE^2`, for sampling sparser both ways, found more on the
 /// own simulator's locations but at precision 0.877 against 0.950.)
-fn coarser(p: &Params) -> Params {
+pub(super) fn coarser(p: &Params) -> Params {
     let mut q = p.clone();
     q.min_inliers = p.min_inliers.div_ceil(SCALE_INT);
     for s in [&mut q.other, &mut q.ground] {

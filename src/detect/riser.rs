@@ -13,8 +13,12 @@
 //! 1. Every ordered pair of near-horizontal primitives within 5 degrees of
 //!    each other: the upper one's outline (its edges within reach of the
 //!    points' box) is sampled every `cell`, and a
-//!    sample is kept where the lower one's outline lies within its
-//!    clustering tolerance (in plan) and the upper surface stands between
+//!    sample is kept where the lower one's outline lies within the
+//!    larger of the two surfaces' clustering tolerances (in plan; each
+//!    scaled as its outline radius is, [`Primitive::cluster_tolerance`]:
+//!    one-shot detection's coarse pass traces a sparse sidewalk on cells
+//!    three times as wide, and its outline lies as much farther from the
+//!    curb) and the upper surface stands between
 //!    the lower one's inlier distance and `minWidth` above it (lower steps
 //!    are one surface; higher faces are found by the cascade itself). Runs
 //!    of kept samples are cut into straight segments.
@@ -37,6 +41,8 @@
 //!    range beyond `groundClusterRange`: a laser ring hits a curb's face
 //!    only where it crosses the curb's line, so the runs of points on a
 //!    face lie as far apart as the rings do on the ground.
+//!
+//! [`Primitive::cluster_tolerance`]: crate::primitive::Primitive::cluster_tolerance
 
 use crate::geometry::plane::Moments;
 use crate::geometry::polygon::{make_ccw, segment_distance_sq, signed_area};
@@ -127,6 +133,9 @@ struct Surface {
     hi: DVec2,
     rms: f64,
     ground: bool,
+    /// Its clustering tolerance ([`Primitive::cluster_tolerance`]): its
+    /// outline lies within it of the surface's edge.
+    tolerance: f64,
     /// Its points within this distance of it are the surface itself, never
     /// a face's evidence (no segment's margin is smaller).
     noise: f64,
@@ -382,11 +391,19 @@ pub(crate) fn find_risers(
         foot,
         range: p.ground_cluster_range,
     };
-    let reach = p.ground.cluster_tolerance.max(p.other.cluster_tolerance);
+    // The farthest two outlines can lie apart and still meet: the largest
+    // clustering tolerance of the surfaces (a surface traced on coarser
+    // cells has a coarser outline).
+    let reach = primitives
+        .iter()
+        .zip(bound)
+        .filter(|(_, &b)| b)
+        .map(|(q, _)| q.cluster_tolerance(p))
+        .fold(0.0, f64::max);
     let Some(window) = Window::of(pts, origin, reach) else {
         return Vec::new();
     };
-    let surfaces = surfaces(primitives, bound, window, p);
+    let surfaces = surfaces(primitives, bound, window, reach, p);
     if surfaces.iter().flatten().count() < 2 {
         return Vec::new();
     }
@@ -417,10 +434,10 @@ fn surfaces(
     primitives: &[Primitive],
     bound: &[bool],
     window: Window,
+    reach: f64,
     p: &Params,
 ) -> Vec<Option<Surface>> {
     let cos_tilt = libm::cos(MAX_TILT_DEG.to_radians());
-    let reach = p.ground.cluster_tolerance.max(p.other.cluster_tolerance);
     primitives
         .iter()
         .zip(bound)
@@ -451,6 +468,7 @@ fn surfaces(
                 hi,
                 rms: q.rms(),
                 ground: q.ground,
+                tolerance: q.cluster_tolerance(p),
                 noise: MARGIN_FLOOR * p.ground.distance.min(p.other.distance),
                 edges: edge_grid(&plan, reach, window),
                 plan,
@@ -472,7 +490,7 @@ fn segments(surfaces: &[Option<Surface>], window: Window, p: &Params) -> Vec<Seg
                 continue;
             }
             let (su, sl) = (p.surface(u.ground), p.surface(l.ground));
-            let reach = su.cluster_tolerance.max(sl.cluster_tolerance);
+            let reach = u.tolerance.max(l.tolerance);
             if u.lo.x > l.hi.x + reach
                 || l.lo.x > u.hi.x + reach
                 || u.lo.y > l.hi.y + reach
@@ -1048,6 +1066,65 @@ mod tests {
             ..Params::gpp2()
         };
         assert_eq!(detect(&cloud, &p).unwrap().primitives.len(), 3);
+    }
+
+    #[test]
+    fn surfaces_traced_on_coarse_cells_meet_within_their_own_tolerance() {
+        // The road's points stop 0.75 m short of the curb (y = 0), so its
+        // outline and the sidewalk's lie more than 0.5 m apart: beyond the
+        // clustering tolerance (0.5 m) of surfaces traced on the usual
+        // cells, within that of a sidewalk traced on cells three times as
+        // wide (one-shot detection's coarse pass), whose outline is as
+        // coarse.
+        let (mut road, mut sidewalk, mut face) = (Vec::new(), Vec::new(), Vec::new());
+        for i in 0..200 {
+            let x = i as f32 * 0.1 + 0.05;
+            for j in 0..43 {
+                road.extend([x, -5.0 + j as f32 * 0.1 + 0.05, 0.0]);
+            }
+            for j in 0..30 {
+                sidewalk.extend([x, j as f32 * 0.1 + 0.05, 0.15]);
+            }
+            face.extend([x, 0.0, 0.045 + 0.03 * (i % 3) as f32]);
+        }
+        let p = Params {
+            viewpoint: Some([10.0, -3.0, 1.8]),
+            ..Params::gpp2()
+        };
+        let viewpoint = DVec3::new(10.0, -3.0, 1.8);
+        let surface = |pts: &[f32], traced_with: &Params| {
+            let cloud = Cloud::from_flat(pts, 3).unwrap();
+            let policy = CascadePolicy {
+                find_risers: false,
+                ..CascadePolicy::one_shot()
+            };
+            let mut det =
+                Detector::new(traced_with, policy).run(&cloud.points, cloud.origin, viewpoint);
+            assert_eq!(det.primitives.len(), 1);
+            det.primitives.remove(0)
+        };
+        let all: Vec<f32> = [&road[..], &sidewalk[..], &face[..]].concat();
+        let cloud = Cloud::from_flat(&all, 3).unwrap();
+        let labels = vec![NO_PRIMITIVE; cloud.len()];
+        let risers = |sidewalk_traced_with: &Params| {
+            let surfaces = [surface(&road, &p), surface(&sidewalk, sidewalk_traced_with)];
+            super::find_risers(
+                &surfaces,
+                &[true, true],
+                &|_| None,
+                &labels,
+                &cloud.points,
+                cloud.origin,
+                viewpoint,
+                &p,
+                p.min_area,
+                None,
+            )
+        };
+        assert!(risers(&p).is_empty());
+        let found = risers(&crate::detect::coarse::coarser(&p));
+        assert_eq!(found.len(), 1);
+        assert!((found[0].0.area - 3.0).abs() < 0.05, "{}", found[0].0.area);
     }
 
     #[test]
