@@ -31,11 +31,26 @@
 //!    curb fall away). Faces on one line that overlap or lie within
 //!    `2 * alpha` (grown as below) merge, across pairs of surfaces (a curb
 //!    runs past several pieces of road, and a far one's outline is jagged).
+//!    In one-shot detection
+//!    ([`CascadePolicy::riser_run_on`](super::CascadePolicy::riser_run_on))
+//!    each face then runs on along its line past its ends for as long as
+//!    the lower surface's outline follows the line (within the reach of
+//!    step 1); the points near that whole stretch are its evidence again,
+//!    fitted as in this step, and the faces merge once more. A curb goes
+//!    on where a tree pit or a driveway pulls the sidewalk's outline back
+//!    from it: the road still ends at it. There a face is dropped when
+//!    less than a quarter of its points lie in either half of the step:
+//!    one run on from a short, higher surface (a car's bumper over the
+//!    curb) holds the curb's points in its foot only.
 //! 4. A face is cut where its points leave a gap wider than `2 * alpha`;
 //!    a piece is kept when its points cover at least `minOccupancy` of its
 //!    length (each point the `cell` after it) and its area (length times
-//!    step) is at least `minArea`. Its outline is the rectangle between the
-//!    two surfaces; its points are labelled with it. When the points come
+//!    step) is at least `minArea`, or, smaller, when it is at least as long
+//!    as the widest gap a piece may hold and the pieces of its face that
+//!    long add up to `minArea` (a curb seen between parked cars a few
+//!    metres at a time). Each piece's outline is the rectangle between the
+//!    two surfaces over its own points (none spans a gap, where nothing was
+//!    seen); its points are labelled with it. When the points come
 //!    from one sensor whose position is known ([`Spacing`]), the gaps of
 //!    steps 3 and 4 and each point's length grow with the square of the
 //!    range beyond `groundClusterRange`: a laser ring hits a curb's face
@@ -136,6 +151,8 @@ struct Surface {
     /// Its clustering tolerance ([`Primitive::cluster_tolerance`]): its
     /// outline lies within it of the surface's edge.
     tolerance: f64,
+    /// Its footprint's cell (m): its outline's resolution.
+    cell: f64,
     /// Its points within this distance of it are the surface itself, never
     /// a face's evidence (no segment's margin is smaller).
     noise: f64,
@@ -269,6 +286,8 @@ struct Segment {
 
 /// A riser before its final checks: its surfaces, its line and its points.
 struct Face {
+    /// The segment it was found on (after a merge, the first member's).
+    segment: usize,
     lower: Plane,
     upper: Plane,
     /// A point on the line and its unit direction (plan).
@@ -283,7 +302,9 @@ struct Face {
 impl Face {
     /// A face on the line through `at` along `dir`, of the points within
     /// `tol` of it.
+    #[allow(clippy::too_many_arguments)]
     fn new(
+        segment: usize,
         lower: Plane,
         upper: Plane,
         at: DVec2,
@@ -301,6 +322,7 @@ impl Face {
                 (a.min(s), b.max(s))
             });
         Face {
+            segment,
             lower,
             upper,
             at,
@@ -332,7 +354,8 @@ impl Plan<'_> {
 /// them and leave the support count of the surface they were labelled
 /// with. That surface's moments stay: they are the statistics of its
 /// robust refit (which trims most points this far off its plane), not a
-/// sum over its labels. `foot`: as for [`find_risers`].
+/// sum over its labels. `foot`, `run_on`: as for [`find_risers`].
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn add_risers(
     primitives: &mut Vec<Primitive>,
     labels: &mut [u32],
@@ -341,12 +364,13 @@ pub(crate) fn add_risers(
     viewpoint: DVec3,
     p: &Params,
     foot: Option<DVec2>,
+    run_on: bool,
 ) {
     let n = primitives.len();
     let every = vec![true; n];
     let slot = |l: u32| ((l as usize) < n).then_some(l as usize);
     let found = find_risers(
-        primitives, &every, &slot, labels, pts, origin, viewpoint, p, p.min_area, foot,
+        primitives, &every, &slot, labels, pts, origin, viewpoint, p, p.min_area, foot, run_on,
     );
     for (r, points) in found {
         if primitives.len() >= p.max_primitives {
@@ -370,10 +394,14 @@ pub(crate) fn add_risers(
 /// [`NO_PRIMITIVE`]; `slot` turns a label into an index of `primitives`
 /// (`None`: a primitive not among them, whose points are no evidence).
 /// Points of a riser can hold a label of another one found here (the
-/// caller labels them in order, the last riser keeping them). Risers
-/// smaller than `min_area` are left out. `foot`: the plan position of the
-/// one sensor the points were seen from, if known, which sets how far
-/// apart their evidence may lie ([`Spacing`]).
+/// caller labels them in order, the last riser keeping them). A riser
+/// smaller than `min_area` is left out unless the pieces of its face add
+/// up to it (step 4 of the module documentation). `foot`: the plan
+/// position of the one sensor the points were seen from, if known, which
+/// sets how far apart their evidence may lie ([`Spacing`]). `run_on`:
+/// whether faces run on along the lower surface's edge, and faces that
+/// do not fill their step are dropped
+/// ([`CascadePolicy::riser_run_on`](super::CascadePolicy::riser_run_on)).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn find_risers(
     primitives: &[Primitive],
@@ -386,6 +414,7 @@ pub(crate) fn find_risers(
     p: &Params,
     min_area: f64,
     foot: Option<DVec2>,
+    run_on: bool,
 ) -> Vec<(Primitive, Vec<u32>)> {
     let spacing = Spacing {
         foot,
@@ -415,15 +444,47 @@ pub(crate) fn find_risers(
     let tol = p.other.distance;
     let mut faces: Vec<Face> = segments
         .iter()
-        .filter_map(|s| fit_face(s, &surfaces, pts, origin, tol))
+        .enumerate()
+        .filter_map(|(k, s)| fit_face(k, s, &surfaces, pts, origin, tol))
         .collect();
     merge_faces(&mut faces, pts, origin, tol, 2.0 * p.other.alpha, spacing);
-    let mut out = Vec::new();
-    for face in &faces {
-        for piece in split(face, pts, origin, 2.0 * p.other.alpha, spacing) {
-            let plan = Plan { pts, origin };
-            out.extend(riser(face, &piece, plan, viewpoint, p, min_area, spacing));
+    // Step 3, on along the lower surface's edge.
+    let (mut more, owner) = if run_on {
+        run_on_edges(&faces, &segments, &surfaces, window)
+    } else {
+        (Vec::new(), Vec::new())
+    };
+    if !more.is_empty() {
+        gather_evidence(&mut more, &surfaces, slot, labels, pts, origin);
+        for (s, &k) in more.iter().zip(&owner) {
+            if let Some(face) = fit_face(faces[k].segment, s, &surfaces, pts, origin, tol) {
+                faces[k] = face;
+            }
         }
+        merge_faces(&mut faces, pts, origin, tol, 2.0 * p.other.alpha, spacing);
+    }
+    // Step 4. A face seen in pieces (a curb behind parked cars) is one
+    // surface: a piece too small alone is kept when it is at least as long
+    // as the gaps `split` allows and such pieces of its face add up to
+    // `min_area`.
+    let mut out = Vec::new();
+    let plan = Plan { pts, origin };
+    for face in &faces {
+        if run_on && !fills_step(face, plan) {
+            continue;
+        }
+        let found: Vec<(Primitive, Vec<u32>, bool)> =
+            split(face, pts, origin, 2.0 * p.other.alpha, spacing)
+                .iter()
+                .filter_map(|piece| riser(face, piece, plan, viewpoint, p, spacing))
+                .collect();
+        let total: f64 = found.iter().filter(|f| f.2).map(|f| f.0.area).sum();
+        out.extend(
+            found
+                .into_iter()
+                .filter(|(r, _, long)| r.area >= min_area || *long && total >= min_area)
+                .map(|(r, points, _)| (r, points)),
+        );
     }
     out
 }
@@ -469,6 +530,7 @@ fn surfaces(
                 rms: q.rms(),
                 ground: q.ground,
                 tolerance: q.cluster_tolerance(p),
+                cell: q.footprint.cell(),
                 noise: MARGIN_FLOOR * p.ground.distance.min(p.other.distance),
                 edges: edge_grid(&plan, reach, window),
                 plan,
@@ -694,6 +756,7 @@ fn gather_evidence(
 
 /// Step 3: the line a segment's evidence lies along (within `tol`).
 fn fit_face(
+    k: usize,
     s: &Segment,
     surfaces: &[Option<Surface>],
     pts: &[Vec3],
@@ -726,8 +789,75 @@ fn fit_face(
             .collect();
         (at, dir) = line_fit(plan, &points, dir)?;
     }
-    let face = Face::new(lower.plane, upper.plane, at, dir, points, plan, tol);
+    let face = Face::new(k, lower.plane, upper.plane, at, dir, points, plan, tol);
     (face.points.len() >= 3).then_some(face)
+}
+
+/// Step 3, on along the lower surface's edge: a face runs on past its
+/// ends along its line as far as the lower surface's outline stays within
+/// the reach of its segment, sampled every cell of that surface's
+/// footprint (a curb goes on where a tree pit or a driveway pulls the
+/// upper surface's outline back from it, and the road still ends at it).
+/// Each face that runs on gives a segment on its line from end to end,
+/// with the face's index, whose evidence is fitted again as the first
+/// segments' was.
+fn run_on_edges(
+    faces: &[Face],
+    segments: &[Segment],
+    surfaces: &[Option<Surface>],
+    window: Window,
+) -> (Vec<Segment>, Vec<usize>) {
+    let (mut out, mut owner) = (Vec::new(), Vec::new());
+    for (k, f) in faces.iter().enumerate() {
+        let s = &segments[f.segment];
+        let Some(lower) = &surfaces[s.lower] else {
+            continue;
+        };
+        if f.points.is_empty() {
+            continue;
+        }
+        let step = lower.cell;
+        let [a, b] = [(f.lo, -f.dir), (f.hi, f.dir)].map(|(end, dir)| {
+            let mut q = f.at + f.dir * end;
+            while window.meets(q + dir * step, q + dir * step)
+                && lower.near_outline(q + dir * step, s.reach)
+            {
+                q += dir * step;
+            }
+            q
+        });
+        if a != f.at + f.dir * f.lo || b != f.at + f.dir * f.hi {
+            out.push(Segment {
+                lower: s.lower,
+                upper: s.upper,
+                a,
+                b,
+                margin: s.margin,
+                reach: s.reach,
+                face: Vec::new(),
+            });
+            owner.push(k);
+        }
+    }
+    (out, owner)
+}
+
+/// Whether a face's points fill its step: at least a quarter of them lie
+/// in each half of it. A face run on along a curb from a short, higher
+/// surface (a car's bumper over it) holds the curb's points in its foot
+/// only.
+fn fills_step(face: &Face, plan: Plan) -> bool {
+    let up = face
+        .points
+        .iter()
+        .filter(|&&i| {
+            let w = plan.origin + plan.pts[i as usize].as_dvec3();
+            let foot = height(&face.lower, w.truncate());
+            w.z - foot >= 0.5 * (height(&face.upper, w.truncate()) - foot)
+        })
+        .count();
+    let n = face.points.len();
+    4 * up >= n && 4 * up <= 3 * n
 }
 
 /// Least-squares line through the points `idx` in plan: its centroid and
@@ -813,7 +943,9 @@ fn merge_faces(
                 points.dedup();
                 let f = &faces[r];
                 if let Some((at, dir)) = line_fit(plan, &points, f.dir) {
-                    next.push(Face::new(f.lower, f.upper, at, dir, points, plan, tol));
+                    next.push(Face::new(
+                        f.segment, f.lower, f.upper, at, dir, points, plan, tol,
+                    ));
                 }
             }
         }
@@ -889,17 +1021,19 @@ fn split(face: &Face, pts: &[Vec3], origin: DVec3, gap: f64, spacing: Spacing) -
     out
 }
 
-/// Step 4: the riser primitive of a piece of a face, if it passes, and
-/// its points (those of the piece within the inlier distance of its plane).
+/// Step 4: the riser primitive of a piece of a face, if its points cover
+/// enough of it, its points (those of the piece within the inlier distance
+/// of its plane), and whether it is at least as long as the widest gap
+/// [`split`] leaves within it (`2 * alpha` times the [`Spacing`] at its
+/// middle).
 fn riser(
     face: &Face,
     piece: &[u32],
     plan: Plan,
     viewpoint: DVec3,
     p: &Params,
-    min_area: f64,
     spacing: Spacing,
-) -> Option<(Primitive, Vec<u32>)> {
+) -> Option<(Primitive, Vec<u32>, bool)> {
     let Plan { pts, origin } = plan;
     let world = |i: u32| origin + pts[i as usize].as_dvec3();
     let (at, dir) = line_fit(plan, piece, face.dir)?;
@@ -964,9 +1098,10 @@ fn riser(
     let mut outline: Vec<DVec2> = corners.iter().map(|&c| frame.to_local(c)).collect();
     make_ccw(&mut outline);
     let area = signed_area(&outline);
-    if area.is_nan() || area < min_area {
+    if area.is_nan() {
         return None;
     }
+    let long = s1 - s0 >= 2.0 * p.other.alpha * spacing.scale(at + dir * (0.5 * (s0 + s1)));
     let mut footprint = Footprint::new(cell);
     let local: Vec<DVec2> = kept.iter().map(|&i| frame.to_local(world(i))).collect();
     footprint.mark_all(&local);
@@ -983,7 +1118,7 @@ fn riser(
         born_scan: 0,
         last_scan: 0,
     };
-    Some((riser, kept))
+    Some((riser, kept, long))
 }
 
 #[cfg(test)]
@@ -1119,12 +1254,89 @@ mod tests {
                 &p,
                 p.min_area,
                 None,
+                true,
             )
         };
         assert!(risers(&p).is_empty());
         let found = risers(&crate::detect::coarse::coarser(&p));
         assert_eq!(found.len(), 1);
         assert!((found[0].0.area - 3.0).abs() < 0.05, "{}", found[0].0.area);
+    }
+
+    #[test]
+    fn a_curb_seen_in_pieces_between_tree_pits_is_kept_in_pieces() {
+        // A road (z = 0, y < 0) and a sidewalk 0.15 m higher (y > 0) along
+        // 30 m. Every 6 m a tree pit 2.6 m long pulls the sidewalk back
+        // to y = 1.5, and the curb's face is seen only between two pits,
+        // over 3 m (parked cars hide the rest): a piece of 0.45 m^2, under
+        // `minArea` (1.5 m^2) alone. The road ends at the curb all along.
+        let scene = |pieces: usize| {
+            let mut pts: Vec<f32> = Vec::new();
+            for i in 0..300 {
+                let x = i as f32 * 0.1 + 0.05;
+                for j in 0..50 {
+                    pts.extend([x, -5.0 + j as f32 * 0.1 + 0.05, 0.0]);
+                }
+                let pit = (x - 3.2).rem_euclid(6.0) < 2.6;
+                for j in 0..30 {
+                    let y = j as f32 * 0.1 + 0.05;
+                    if !pit || y > 1.5 {
+                        pts.extend([x, y, 0.15]);
+                    }
+                }
+            }
+            for k in 0..pieces {
+                for m in 0..60 {
+                    let x = k as f32 * 6.0 + m as f32 * 0.05 + 0.025;
+                    pts.extend([x, 0.0, 0.045 + 0.03 * (m % 3) as f32]);
+                }
+            }
+            pts
+        };
+        let risers = |pts: &[f32]| -> Vec<f64> {
+            let (_, det) = run(pts, CascadePolicy::one_shot());
+            det.primitives
+                .iter()
+                .filter(|q| q.plane.normal.z.abs() < 0.1)
+                .map(|q| q.area)
+                .collect()
+        };
+        // Five pieces: one face, 2.25 m^2 in all, kept as its pieces (no
+        // polygon spans the gaps, where nothing was seen).
+        let all = risers(&scene(5));
+        assert_eq!(all.len(), 5, "{all:?}");
+        assert!(all.iter().all(|a| (a - 0.45).abs() < 0.02), "{all:?}");
+        // One piece alone is too small.
+        assert!(risers(&scene(1)).is_empty());
+    }
+
+    #[test]
+    fn a_curb_does_not_run_on_under_a_higher_surface_beside_it() {
+        // The curb of `curb` (0.15 m, its face seen all along) and, on the
+        // sidewalk at its edge, the top of a box 0.35 m high (x 8-12 m,
+        // y 0-1.5 m) whose front overhangs the curb (nothing seen on it).
+        // The box's top and the road meet a step of 0.35 m apart, and the
+        // road's outline runs on along the curb, but only the foot of that
+        // step holds points: one riser, the curb.
+        let mut pts = curb(0.15, 400);
+        for i in 0..40 {
+            for j in 0..15 {
+                pts.extend([8.05 + i as f32 * 0.1, 0.05 + j as f32 * 0.1, 0.35]);
+            }
+        }
+        let (_, det) = run(&pts, CascadePolicy::one_shot());
+        let risers: Vec<_> = det
+            .primitives
+            .iter()
+            .filter(|q| q.plane.normal.z.abs() < 0.1)
+            .collect();
+        assert_eq!(risers.len(), 1, "{}", risers.len());
+        let top = risers[0]
+            .vertices()
+            .iter()
+            .map(|v| v.z)
+            .fold(f64::MIN, f64::max);
+        assert!((top - 0.15).abs() < 0.01, "{top}");
     }
 
     #[test]
@@ -1232,7 +1444,18 @@ mod tests {
         let upper = Plane::from_point_normal(DVec3::new(0.0, 1.0, 0.15), DVec3::Z);
         let faces = || -> Vec<Face> {
             runs.iter()
-                .map(|r| Face::new(lower, upper, plan.at(r[0]), DVec2::X, r.clone(), plan, 0.08))
+                .map(|r| {
+                    Face::new(
+                        0,
+                        lower,
+                        upper,
+                        plan.at(r[0]),
+                        DVec2::X,
+                        r.clone(),
+                        plan,
+                        0.08,
+                    )
+                })
                 .collect()
         };
         let joined = |foot: Option<DVec2>| {
@@ -1255,6 +1478,7 @@ mod tests {
         // whichever way round, on a line along no axis.
         let d = DVec2::new(0.6, 0.8);
         let face = |at: f64, lo: f64, hi: f64, points: Vec<u32>| Face {
+            segment: 0,
             lower,
             upper,
             at: d * at,
