@@ -38,10 +38,12 @@
 //!    step 1); the points near that whole stretch are its evidence again,
 //!    fitted as in this step, and the faces merge once more. A curb goes
 //!    on where a tree pit or a driveway pulls the sidewalk's outline back
-//!    from it: the road still ends at it. There a face is dropped when
-//!    less than a quarter of its points lie in either half of the step:
-//!    one run on from a short, higher surface (a car's bumper over the
-//!    curb) holds the curb's points in its foot only.
+//!    from it: the road still ends at it. With that rule, every face is
+//!    dropped when less than a quarter of its points lie in either half of
+//!    the step: one run on from a short, higher surface (a car's bumper
+//!    over the curb) holds the curb's points in its foot only. A face
+//!    follows the lower surface of the first segment it was found on, so
+//!    it runs on along one piece of road.
 //! 4. A face is cut where its points leave a gap wider than `2 * alpha`;
 //!    a piece is kept when its points cover at least `minOccupancy` of its
 //!    length (each point the `cell` after it) and its area (length times
@@ -286,7 +288,9 @@ struct Segment {
 
 /// A riser before its final checks: its surfaces, its line and its points.
 struct Face {
-    /// The segment it was found on (after a merge, the first member's).
+    /// The segment it was first found on (after a merge, the first
+    /// member's; after running on, still the one it ran on from): its
+    /// surfaces, margin and reach.
     segment: usize,
     lower: Plane,
     upper: Plane,
@@ -395,8 +399,9 @@ pub(crate) fn add_risers(
 /// (`None`: a primitive not among them, whose points are no evidence).
 /// Points of a riser can hold a label of another one found here (the
 /// caller labels them in order, the last riser keeping them). A riser
-/// smaller than `min_area` is left out unless the pieces of its face add
-/// up to it (step 4 of the module documentation). `foot`: the plan
+/// smaller than `min_area` is left out unless it is at least `2 * alpha`
+/// long (times the [`Spacing`] at its middle) and the pieces of its face
+/// that long add up to `min_area` (step 4 of the module documentation). `foot`: the plan
 /// position of the one sensor the points were seen from, if known, which
 /// sets how far apart their evidence may lie ([`Spacing`]). `run_on`:
 /// whether faces run on along the lower surface's edge, and faces that
