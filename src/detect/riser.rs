@@ -62,7 +62,7 @@
 //! [`Primitive::cluster_tolerance`]: crate::primitive::Primitive::cluster_tolerance
 
 use crate::geometry::plane::Moments;
-use crate::geometry::polygon::{make_ccw, segment_distance_sq, signed_area};
+use crate::geometry::polygon::{contains, make_ccw, segment_distance_sq, signed_area};
 use crate::geometry::{bounds, grow_box, Footprint, Frame, Plane};
 use crate::params::Params;
 use crate::primitive::{Primitive, NO_PRIMITIVE};
@@ -358,7 +358,11 @@ impl Plan<'_> {
 /// them and leave the support count of the surface they were labelled
 /// with. That surface's moments stay: they are the statistics of its
 /// robust refit (which trims most points this far off its plane), not a
-/// sum over its labels. `foot`, `run_on`: as for [`find_risers`].
+/// sum over its labels. A riser most of whose points lie on a primitive
+/// already there (within the non-ground inlier distance of its plane,
+/// facing its way within 5 degrees, inside its outline) is the foot of
+/// that primitive (a low wall whose lowest rows its cluster left out) and
+/// is not added. `foot`, `run_on`: as for [`find_risers`].
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn add_risers(
     primitives: &mut Vec<Primitive>,
@@ -376,9 +380,22 @@ pub(crate) fn add_risers(
     let found = find_risers(
         primitives, &every, &slot, labels, pts, origin, viewpoint, p, p.min_area, foot, run_on,
     );
+    let cos_parallel = libm::cos(PARALLEL_DEG.to_radians());
     for (r, points) in found {
         if primitives.len() >= p.max_primitives {
             return;
+        }
+        let known = primitives.iter().any(|q| {
+            let on = |&&i: &&u32| {
+                let w = origin + pts[i as usize].as_dvec3();
+                q.plane.signed_distance(w).abs() <= p.other.distance
+                    && contains(&q.outline, q.frame.to_local(w))
+            };
+            q.plane.normal.dot(r.plane.normal).abs() >= cos_parallel
+                && 2 * points.iter().filter(on).count() > points.len()
+        });
+        if known {
+            continue;
         }
         let id = primitives.len() as u32;
         // The points move from the surface they supported, if any.
@@ -1342,6 +1359,57 @@ mod tests {
             .map(|v| v.z)
             .fold(f64::MIN, f64::max);
         assert!((top - 0.15).abs() < 0.01, "{top}");
+    }
+
+    #[test]
+    fn a_riser_in_the_foot_of_a_primitive_already_there_is_not_added() {
+        // A wall stands on the curb's line (y = 0) from the road up to
+        // 5 m, its rows every 0.05 m (found first, the largest surface);
+        // say its cluster left out the rows between the road and the
+        // sidewalk, which fill the step. They are the wall's foot, inside
+        // its outline: no riser over it.
+        let mut pts = curb(0.15, 0);
+        for i in 0..200 {
+            for j in 0..=100 {
+                pts.extend([i as f32 * 0.1 + 0.05, 0.0, j as f32 * 0.05]);
+            }
+        }
+        let cloud = Cloud::from_flat(&pts, 3).unwrap();
+        let p = Params {
+            viewpoint: Some([10.0, -3.0, 1.8]),
+            ..Params::gpp2()
+        };
+        let viewpoint = DVec3::new(10.0, -3.0, 1.8);
+        let policy = CascadePolicy {
+            find_risers: false,
+            ..CascadePolicy::one_shot()
+        };
+        let mut det = Detector::new(&p, policy).run(&cloud.points, cloud.origin, viewpoint);
+        let wall = det
+            .primitives
+            .iter()
+            .position(|q| q.plane.normal.z.abs() < 0.1);
+        assert!(
+            wall.is_some() && det.primitives.len() == 3,
+            "road, sidewalk, wall"
+        );
+        for i in 0..cloud.len() {
+            let w = cloud.world(i);
+            if w.y == 0.0 && w.z > 0.01 && w.z < 0.14 {
+                det.labels[i] = NO_PRIMITIVE;
+            }
+        }
+        super::add_risers(
+            &mut det.primitives,
+            &mut det.labels,
+            &cloud.points,
+            cloud.origin,
+            viewpoint,
+            &p,
+            None,
+            true,
+        );
+        assert_eq!(det.primitives.len(), 3);
     }
 
     #[test]
