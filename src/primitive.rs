@@ -4,7 +4,7 @@
 
 use crate::floor::GroundRule;
 use crate::geometry::plane::{robust_fit, RobustFit};
-use crate::geometry::polygon::signed_area;
+use crate::geometry::polygon::{contains, signed_area};
 use crate::geometry::{convex_hull, Footprint, Frame, Moments, Plane, Polygon3};
 use crate::params::{HullKind, Params, SolidityKind};
 use glam::{DMat3, DVec2, DVec3, Vec3};
@@ -78,6 +78,13 @@ impl Primitive {
             frame: self.frame,
             ring: self.outline.clone(),
         }
+    }
+
+    /// Whether the world point `w` lies on this polygon: within `within`
+    /// (m) of its plane and inside its outline.
+    pub(crate) fn holds(&self, w: DVec3, within: f64) -> bool {
+        self.plane.signed_distance(w).abs() <= within
+            && contains(&self.outline, self.frame.to_local(w))
     }
 
     /// RMS distance of the (robust inner) support from the plane (m).

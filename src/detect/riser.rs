@@ -62,7 +62,7 @@
 //! [`Primitive::cluster_tolerance`]: crate::primitive::Primitive::cluster_tolerance
 
 use crate::geometry::plane::Moments;
-use crate::geometry::polygon::{contains, make_ccw, segment_distance_sq, signed_area};
+use crate::geometry::polygon::{make_ccw, segment_distance_sq, signed_area};
 use crate::geometry::{bounds, grow_box, Footprint, Frame, Plane};
 use crate::params::Params;
 use crate::primitive::{Primitive, NO_PRIMITIVE};
@@ -386,11 +386,7 @@ pub(crate) fn add_risers(
             return;
         }
         let known = primitives.iter().any(|q| {
-            let on = |&&i: &&u32| {
-                let w = origin + pts[i as usize].as_dvec3();
-                q.plane.signed_distance(w).abs() <= p.other.distance
-                    && contains(&q.outline, q.frame.to_local(w))
-            };
+            let on = |&&i: &&u32| q.holds(origin + pts[i as usize].as_dvec3(), p.other.distance);
             q.plane.normal.dot(r.plane.normal).abs() >= cos_parallel
                 && 2 * points.iter().filter(on).count() > points.len()
         });

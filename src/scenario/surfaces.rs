@@ -123,8 +123,7 @@ impl Surfaces<'_> {
     pub fn holds(&self, w: DVec3, params: &Params) -> bool {
         self.near(w).any(|k| {
             let prim = &self.prims[k];
-            prim.plane.signed_distance(w).abs() <= seen_slack(prim, params)
-                && crate::geometry::polygon::contains(&prim.outline, prim.frame.to_local(w))
+            prim.holds(w, seen_slack(prim, params))
         })
     }
 }
