@@ -62,16 +62,15 @@ pub fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
     } else {
         (b, a, &av)
     };
-    let ms = small_v
-        .iter()
-        .copied()
-        .chain([small.moments.mean()])
-        .map(|p| {
-            let d = big.plane.signed_distance(p);
-            d * d
-        })
-        .sum::<f64>()
-        / (small_v.len() + 1) as f64;
+    let mut ms = mean_square(small_v, small, big);
+    // Two pieces of about one size: neither plane is the better reference
+    // (a strip one ring wide has a tilt across it that its points hardly
+    // fix, and extended over a piece beside it, such a plane can pass
+    // through a surface a curb higher), so each is judged on the other's.
+    if big.area < 2.0 * small.area {
+        let big_v = if std::ptr::eq(big, a) { &av } else { &bv };
+        ms = ms.max(mean_square(big_v, big, small));
+    }
     // Or each centroid on the other's plane (two slightly tilted pieces of
     // one surface whose far vertices disagree).
     let (ca, cb) = (a.moments.mean(), b.moments.mean());
@@ -98,6 +97,21 @@ pub fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
     // The outlines, both in a's frame: touching or overlapping?
     let b_in_a: Vec<DVec2> = bv.iter().map(|&v| a.frame.to_local(v)).collect();
     rings_within(&a.outline, &b_in_a, params.merge_gap)
+}
+
+/// The mean square distance from `to`'s plane of `of`'s outline vertices
+/// (`vertices`, world) and centroid.
+fn mean_square(vertices: &[DVec3], of: &Primitive, to: &Primitive) -> f64 {
+    vertices
+        .iter()
+        .copied()
+        .chain([of.moments.mean()])
+        .map(|p| {
+            let d = to.plane.signed_distance(p);
+            d * d
+        })
+        .sum::<f64>()
+        / (vertices.len() + 1) as f64
 }
 
 /// Do at least three quarters of `vertices` (world) lie within `gap` of

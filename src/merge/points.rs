@@ -787,4 +787,45 @@ mod tests {
         let (prims, _, _) = two(&road, &again, &p);
         assert!(mergeable(&prims[0], &prims[1], &p), "the road seen again");
     }
+
+    /// A road strip whose plane leans 2 degrees across its width (as a
+    /// strip one ring wide can be fitted), and beside it a piece of
+    /// sidewalk 15 cm up, of about its size, where the strip's plane
+    /// extended passes through the sidewalk: the sidewalk's outline lies
+    /// within `mergeDistance` of that plane, but the strip's does not lie
+    /// on the sidewalk's, and they stay apart. Two level pieces of about
+    /// one size that touch still merge.
+    #[test]
+    fn a_leaning_strip_and_a_piece_of_its_size_a_curb_up_stay_apart() {
+        let p = Params::gpp2();
+        let lean = 2f64.to_radians().tan();
+        let grid = |x: (f64, f64), z: &dyn Fn(f64) -> f64| {
+            let mut out = Vec::new();
+            let mut u = x.0 + 0.05;
+            while u < x.1 {
+                let mut v = 0.05;
+                while v < 11.0 {
+                    out.push(Vec3::new(u as f32, v as f32, z(u) as f32));
+                    v += 0.1;
+                }
+                u += 0.1;
+            }
+            out
+        };
+        let strip = grid((-0.6, 3.3), &|u| lean * u);
+        let sidewalk = grid((3.4, 5.6), &|_| 0.15);
+        let (prims, _, _) = two(&strip, &sidewalk, &p);
+        assert!(prims[0].area < 2.0 * prims[1].area);
+        // The sidewalk's outline on the strip's plane, by the RMS distance.
+        let v = prims[1].vertices();
+        let ms = v
+            .iter()
+            .map(|&q| prims[0].plane.signed_distance(q).powi(2))
+            .sum::<f64>();
+        assert!((ms / v.len() as f64).sqrt() < p.merge_distance);
+        assert!(!mergeable(&prims[0], &prims[1], &p));
+        let (a, b) = (grid((0.0, 3.9), &|_| 0.0), grid((4.0, 6.0), &|_| 0.0));
+        let (prims, _, _) = two(&a, &b, &p);
+        assert!(mergeable(&prims[0], &prims[1], &p));
+    }
 }
