@@ -62,7 +62,7 @@
 //! [`Primitive::cluster_tolerance`]: crate::primitive::Primitive::cluster_tolerance
 
 use crate::geometry::plane::Moments;
-use crate::geometry::polygon::{make_ccw, segment_distance_sq, signed_area};
+use crate::geometry::polygon::{make_ccw, rings_within, segment_distance_sq, signed_area};
 use crate::geometry::{bounds, grow_box, Footprint, Frame, Plane};
 use crate::params::Params;
 use crate::primitive::{Primitive, NO_PRIMITIVE};
@@ -358,11 +358,14 @@ impl Plan<'_> {
 /// them and leave the support count of the surface they were labelled
 /// with. That surface's moments stay: they are the statistics of its
 /// robust refit (which trims most points this far off its plane), not a
-/// sum over its labels. A riser most of whose points lie on a primitive
-/// already there (within the non-ground inlier distance of its plane,
-/// facing its way within 5 degrees, inside its outline) is the foot of
-/// that primitive (a low wall whose lowest rows its cluster left out) and
-/// is not added. `foot`, `run_on`: as for [`find_risers`].
+/// sum over its labels. A riser most of whose points lie on the plane of
+/// a primitive already there (within the non-ground inlier distance,
+/// facing its way within 5 degrees) and whose outline meets that
+/// primitive's is part of it (the foot of a wall whose lowest rows its
+/// cluster left out, or a curb on the line of a wall that stands on it):
+/// it is taken into that primitive ([`absorb`](crate::merge::stats::absorb)),
+/// as the merge pass before would have taken a piece, not added over it.
+/// `foot`, `run_on`: as for [`find_risers`].
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn add_risers(
     primitives: &mut Vec<Primitive>,
@@ -382,18 +385,21 @@ pub(crate) fn add_risers(
     );
     let cos_parallel = libm::cos(PARALLEL_DEG.to_radians());
     for (r, points) in found {
-        if primitives.len() >= p.max_primitives {
-            return;
-        }
-        let known = primitives.iter().any(|q| {
-            let on = |&&i: &&u32| q.holds(origin + pts[i as usize].as_dvec3(), p.other.distance);
+        let rv = r.vertices();
+        let part_of = primitives.iter().position(|q| {
+            let on = |&&i: &&u32| {
+                let w = origin + pts[i as usize].as_dvec3();
+                q.plane.signed_distance(w).abs() <= p.other.distance
+            };
+            let ring: Vec<DVec2> = rv.iter().map(|&v| q.frame.to_local(v)).collect();
             q.plane.normal.dot(r.plane.normal).abs() >= cos_parallel
                 && 2 * points.iter().filter(on).count() > points.len()
+                && rings_within(&q.outline, &ring, 0.0)
         });
-        if known {
-            continue;
+        if part_of.is_none() && primitives.len() >= p.max_primitives {
+            return;
         }
-        let id = primitives.len() as u32;
+        let id = part_of.unwrap_or(primitives.len()) as u32;
         // The points move from the surface they supported, if any.
         for &i in &points {
             let old = std::mem::replace(&mut labels[i as usize], id);
@@ -401,7 +407,10 @@ pub(crate) fn add_risers(
                 q.support -= 1;
             }
         }
-        primitives.push(Primitive { id, ..r });
+        match part_of {
+            Some(k) => crate::merge::stats::absorb(&mut primitives[k], &r, p),
+            None => primitives.push(Primitive { id, ..r }),
+        }
     }
 }
 
@@ -1406,6 +1415,74 @@ mod tests {
             true,
         );
         assert_eq!(det.primitives.len(), 3);
+    }
+
+    #[test]
+    fn a_riser_on_the_plane_of_a_wall_it_meets_joins_the_wall() {
+        // The curb's face is seen along its 20 m, and a wall 5 m long
+        // stands on its line (y = 0, x 0-5 m, from the road up), found
+        // before the risers with its rows below the sidewalk left out of
+        // its support. The riser runs the curb's length, most of its points
+        // beyond the wall: it is not added over the wall's foot (two
+        // polygons on one plane, one over the other) but taken into the
+        // wall, which now runs on along the curb.
+        let ground = curb(0.15, 0);
+        let mut wall_pts: Vec<f32> = Vec::new();
+        for i in 0..50 {
+            for j in 0..=100 {
+                wall_pts.extend([i as f32 * 0.1 + 0.05, 0.0, j as f32 * 0.05]);
+            }
+        }
+        let face = &curb(0.15, 400)[ground.len()..];
+        let all: Vec<f32> = [&ground[..], face, &wall_pts[..]].concat();
+        let p = Params {
+            viewpoint: Some([10.0, -3.0, 1.8]),
+            ..Params::gpp2()
+        };
+        let viewpoint = DVec3::new(10.0, -3.0, 1.8);
+        let policy = CascadePolicy {
+            find_risers: false,
+            ..CascadePolicy::one_shot()
+        };
+        let cloud = Cloud::from_flat(&all, 3).unwrap();
+        let detect = |pts: &[f32]| {
+            let c = Cloud::from_flat(pts, 3).unwrap();
+            Detector::new(&p, policy).run(&c.points, c.origin, viewpoint)
+        };
+        let (road, wall) = (detect(&ground), detect(&wall_pts));
+        assert_eq!((road.primitives.len(), wall.primitives.len()), (2, 1));
+        let mut prims = road.primitives.clone();
+        prims.extend(wall.primitives.iter().cloned());
+        let mut labels = road.labels.clone();
+        labels.extend(std::iter::repeat_n(NO_PRIMITIVE, face.len() / 3));
+        for k in 0..wall_pts.len() / 3 {
+            let low = wall_pts[3 * k + 2] < 0.14;
+            labels.push(if low { NO_PRIMITIVE } else { 2 });
+        }
+        let reach = |q: &crate::primitive::Primitive| {
+            q.vertices().iter().map(|v| v.x).fold(f64::MIN, f64::max)
+        };
+        let area = prims[2].area;
+        assert!(reach(&prims[2]) < 5.5);
+        super::add_risers(
+            &mut prims,
+            &mut labels,
+            &cloud.points,
+            cloud.origin,
+            viewpoint,
+            &p,
+            None,
+            true,
+        );
+        assert_eq!(prims.len(), 3);
+        assert!(reach(&prims[2]) > 19.5, "{}", reach(&prims[2]));
+        assert!(prims[2].area > area + 1.0, "{} -> {}", area, prims[2].area);
+        let face = (0..cloud.len()).filter(|&i| {
+            let w = cloud.world(i);
+            w.y == 0.0 && w.x > 6.0 && w.z > 0.01 && w.z < 0.14
+        });
+        assert!(face.clone().count() > 200);
+        assert!(face.into_iter().all(|i| labels[i] == 2));
     }
 
     #[test]
