@@ -388,7 +388,6 @@ impl<'p> Detector<'p> {
                 viewpoint,
                 p,
                 policy.range_pulled_ground.then(|| viewpoint.truncate()),
-                policy.riser_run_on,
             );
         }
         out.time_ms = clock::now_ms() - t0;

@@ -141,15 +141,6 @@ pub struct CascadePolicy {
     /// is narrower than `minWidth` and the two surfaces' inlier slabs take
     /// most of its points, so no round finds it.
     pub find_risers: bool,
-    /// A riser's face runs on along its line for as long as the lower
-    /// surface's outline follows it, and a face with less than a quarter
-    /// of its points in either half of its step is dropped (the `riser`
-    /// module, step 3): a curb goes on past a tree pit. Off in the
-    /// scenario, which grows a curb scan by scan: there it found more
-    /// curbs on the independent bench's drives (crossing 59 -> 66 of 69)
-    /// but left one of the twenty drifting drives with a duplicate pair
-    /// (BENCHMARKS.md, Tried and dropped).
-    pub riser_run_on: bool,
     /// After the rounds, a second cascade at three times the scale
     /// (clustering tolerance, footprint cell, outline radius, sampling
     /// voxel), with a third of `minInliers`, runs on the points no
@@ -215,7 +206,6 @@ impl CascadePolicy {
             judge_without_crossing_bands: false,
             reject_domes: false,
             find_risers: true,
-            riser_run_on: true,
             coarse_pass: false,
             pool_support: false,
         }
@@ -308,7 +298,6 @@ impl CascadePolicy {
             judge_without_crossing_bands: true,
             reject_domes: true,
             find_risers: false,
-            riser_run_on: false,
             coarse_pass: false,
             pool_support: false,
         }

@@ -31,9 +31,7 @@
 //!    curb fall away). Faces on one line that overlap or lie within
 //!    `2 * alpha` (grown as below) merge, across pairs of surfaces (a curb
 //!    runs past several pieces of road, and a far one's outline is jagged).
-//!    In one-shot detection
-//!    ([`CascadePolicy::riser_run_on`](super::CascadePolicy::riser_run_on))
-//!    each face then runs on along its line past its ends for as long as
+//!    Each face then runs on along its line past its ends for as long as
 //!    the lower surface's outline follows the line (within the reach of
 //!    step 1); the points near that whole stretch are its evidence again,
 //!    fitted as in this step, and the faces merge once more. A curb goes
@@ -365,7 +363,7 @@ impl Plan<'_> {
 /// cluster left out, or a curb on the line of a wall that stands on it):
 /// it is taken into that primitive ([`absorb`](crate::merge::stats::absorb)),
 /// as the merge pass before would have taken a piece, not added over it.
-/// `foot`, `run_on`: as for [`find_risers`].
+/// `foot`: as for [`find_risers`].
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn add_risers(
     primitives: &mut Vec<Primitive>,
@@ -375,13 +373,12 @@ pub(crate) fn add_risers(
     viewpoint: DVec3,
     p: &Params,
     foot: Option<DVec2>,
-    run_on: bool,
 ) {
     let n = primitives.len();
     let every = vec![true; n];
     let slot = |l: u32| ((l as usize) < n).then_some(l as usize);
     let found = find_risers(
-        primitives, &every, &slot, labels, pts, origin, viewpoint, p, p.min_area, foot, run_on,
+        primitives, &every, &slot, labels, pts, origin, viewpoint, p, p.min_area, foot,
     );
     let cos_parallel = libm::cos(PARALLEL_DEG.to_radians());
     for (r, points) in found {
@@ -425,10 +422,7 @@ pub(crate) fn add_risers(
 /// long (times the [`Spacing`] at its middle) and the pieces of its face
 /// that long add up to `min_area` (step 4 of the module documentation). `foot`: the plan
 /// position of the one sensor the points were seen from, if known, which
-/// sets how far apart their evidence may lie ([`Spacing`]). `run_on`:
-/// whether faces run on along the lower surface's edge, and faces that
-/// do not fill their step are dropped
-/// ([`CascadePolicy::riser_run_on`](super::CascadePolicy::riser_run_on)).
+/// sets how far apart their evidence may lie ([`Spacing`]).
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn find_risers(
     primitives: &[Primitive],
@@ -441,7 +435,6 @@ pub(crate) fn find_risers(
     p: &Params,
     min_area: f64,
     foot: Option<DVec2>,
-    run_on: bool,
 ) -> Vec<(Primitive, Vec<u32>)> {
     let spacing = Spacing {
         foot,
@@ -476,11 +469,7 @@ pub(crate) fn find_risers(
         .collect();
     merge_faces(&mut faces, pts, origin, tol, 2.0 * p.other.alpha, spacing);
     // Step 3, on along the lower surface's edge.
-    let (mut more, owner) = if run_on {
-        run_on_edges(&faces, &segments, &surfaces, window)
-    } else {
-        (Vec::new(), Vec::new())
-    };
+    let (mut more, owner) = run_on_edges(&faces, &segments, &surfaces, window);
     if !more.is_empty() {
         gather_evidence(&mut more, &surfaces, slot, labels, pts, origin);
         for (s, &k) in more.iter().zip(&owner) {
@@ -497,7 +486,7 @@ pub(crate) fn find_risers(
     let mut out = Vec::new();
     let plan = Plan { pts, origin };
     for face in &faces {
-        if run_on && !fills_step(face, plan) {
+        if !fills_step(face, plan) {
             continue;
         }
         let found: Vec<(Primitive, Vec<u32>, bool)> =
@@ -1281,7 +1270,6 @@ mod tests {
                 &p,
                 p.min_area,
                 None,
-                true,
             )
         };
         assert!(risers(&p).is_empty());
@@ -1412,7 +1400,6 @@ mod tests {
             viewpoint,
             &p,
             None,
-            true,
         );
         assert_eq!(det.primitives.len(), 3);
     }
@@ -1472,7 +1459,6 @@ mod tests {
             viewpoint,
             &p,
             None,
-            true,
         );
         assert_eq!(prims.len(), 3);
         assert!(reach(&prims[2]) > 19.5, "{}", reach(&prims[2]));

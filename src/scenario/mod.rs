@@ -451,7 +451,6 @@ impl Scenario {
             p,
             0.0,
             Some(sensor.truncate()),
-            CascadePolicy::scenario_leftovers().riser_run_on,
         );
         // Those large enough first, each a new primitive; then the pieces
         // too small to stand alone (a scan sees a few metres of a curb),
