@@ -137,7 +137,8 @@ pub struct CascadePolicy {
     pub reject_domes: bool,
     /// After the merge pass, the short faces between two near-horizontal
     /// primitives a step apart (curbs, steps) become primitives of their
-    /// own where points fill the step (see the `riser` module): such a face
+    /// own where points fill the step, or join a primitive on their plane
+    /// whose outline they meet (see the `riser` module): such a face
     /// is narrower than `minWidth` and the two surfaces' inlier slabs take
     /// most of its points, so no round finds it.
     pub find_risers: bool,

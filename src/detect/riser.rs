@@ -5,7 +5,8 @@
 //! take most of its points. But the two surfaces bound it, so where their
 //! outlines meet with a step between them and points fill the step, the
 //! face is there. One-shot detection adds it as a primitive of its own
-//! after its merge pass
+//! after its merge pass (or takes it into a primitive on its plane whose
+//! outline it meets)
 //! ([`CascadePolicy::find_risers`](super::CascadePolicy::find_risers));
 //! the scenario after each scan's detection, from the scan's points.
 //!
@@ -356,7 +357,8 @@ impl Plan<'_> {
 /// them and leave the support count of the surface they were labelled
 /// with. That surface's moments stay: they are the statistics of its
 /// robust refit (which trims most points this far off its plane), not a
-/// sum over its labels. A riser most of whose points lie on the plane of
+/// sum over its labels (a primitive that takes a riser in gains the
+/// riser's moments, as in a merge). A riser most of whose points lie on the plane of
 /// a primitive already there (within the non-ground inlier distance,
 /// facing its way within 5 degrees) and whose outline meets that
 /// primitive's is part of it (the foot of a wall whose lowest rows its
@@ -384,24 +386,28 @@ pub(crate) fn add_risers(
     for (r, points) in found {
         let rv = r.vertices();
         let part_of = primitives.iter().position(|q| {
+            if q.plane.normal.dot(r.plane.normal).abs() < cos_parallel {
+                return false;
+            }
             let on = |&&i: &&u32| {
                 let w = origin + pts[i as usize].as_dvec3();
                 q.plane.signed_distance(w).abs() <= p.other.distance
             };
             let ring: Vec<DVec2> = rv.iter().map(|&v| q.frame.to_local(v)).collect();
-            q.plane.normal.dot(r.plane.normal).abs() >= cos_parallel
-                && 2 * points.iter().filter(on).count() > points.len()
+            2 * points.iter().filter(on).count() > points.len()
                 && rings_within(&q.outline, &ring, 0.0)
         });
         if part_of.is_none() && primitives.len() >= p.max_primitives {
-            return;
+            // No room for it; a later one may still be taken into a
+            // primitive.
+            continue;
         }
         let id = part_of.unwrap_or(primitives.len()) as u32;
         // The points move from the surface they supported, if any.
         for &i in &points {
             let old = std::mem::replace(&mut labels[i as usize], id);
             if let Some(q) = primitives.get_mut(old as usize) {
-                q.support -= 1;
+                q.support = q.support.saturating_sub(1);
             }
         }
         match part_of {

@@ -46,6 +46,11 @@ pub struct MergeEvent {
 ///   road's outline, and is a step; with the defaults `groundDistance`
 ///   equals `mergeDistance`, so every ground layer needs this), half of
 ///   the smaller's support must lie where the larger has support too.
+///
+/// How far one lies from the other's plane is the RMS distance of its
+/// outline vertices and centroid. When the larger has under twice the
+/// smaller's area, neither plane is the better reference: the distance is
+/// taken both ways and the larger counts.
 pub fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
     if a.plane.angle_to(&b.plane) > params.merge_angle.to_radians() {
         return false;
