@@ -1172,13 +1172,41 @@ mod tests {
         pts.into_iter().map(|v| v as f32).collect()
     }
 
-    fn run(pts: &[f32], policy: CascadePolicy) -> (Cloud, crate::detect::Detection) {
-        let cloud = Cloud::from_flat(pts, 3).unwrap();
+    /// The tests' sensor, on the road 3 m from the curb, and the
+    /// parameters that know it.
+    const VIEWPOINT: [f64; 3] = [10.0, -3.0, 1.8];
+
+    fn seen_from_the_road() -> (Params, DVec3) {
         let p = Params {
-            viewpoint: Some([10.0, -3.0, 1.8]),
+            viewpoint: Some(VIEWPOINT),
             ..Params::gpp2()
         };
-        let viewpoint = DVec3::new(10.0, -3.0, 1.8);
+        (p, DVec3::from_array(VIEWPOINT))
+    }
+
+    /// One-shot detection without its riser step.
+    fn no_risers() -> CascadePolicy {
+        CascadePolicy {
+            find_risers: false,
+            ..CascadePolicy::one_shot()
+        }
+    }
+
+    /// A wall on the curb's line (y = 0) from the road up to 5 m, its
+    /// `columns` every 0.1 m along x from 0, its rows every 0.05 m.
+    fn wall(columns: usize) -> Vec<f32> {
+        let mut pts = Vec::new();
+        for i in 0..columns {
+            for j in 0..=100 {
+                pts.extend([i as f32 * 0.1 + 0.05, 0.0, j as f32 * 0.05]);
+            }
+        }
+        pts
+    }
+
+    fn run(pts: &[f32], policy: CascadePolicy) -> (Cloud, crate::detect::Detection) {
+        let cloud = Cloud::from_flat(pts, 3).unwrap();
+        let (p, viewpoint) = seen_from_the_road();
         let det = Detector::new(&p, policy).run(&cloud.points, cloud.origin, viewpoint);
         (cloud, det)
     }
@@ -1212,16 +1240,9 @@ mod tests {
             assert_eq!(q.support, n);
         }
         // Without the rule, no round finds it (too narrow).
-        let off = CascadePolicy {
-            find_risers: false,
-            ..CascadePolicy::one_shot()
-        };
-        assert_eq!(run(&pts, off).1.primitives.len(), 2);
+        assert_eq!(run(&pts, no_risers()).1.primitives.len(), 2);
         // And the public one-shot detection has it.
-        let p = Params {
-            viewpoint: Some([10.0, -3.0, 1.8]),
-            ..Params::gpp2()
-        };
+        let (p, _) = seen_from_the_road();
         assert_eq!(detect(&cloud, &p).unwrap().primitives.len(), 3);
     }
 
@@ -1244,19 +1265,11 @@ mod tests {
             }
             face.extend([x, 0.0, 0.045 + 0.03 * (i % 3) as f32]);
         }
-        let p = Params {
-            viewpoint: Some([10.0, -3.0, 1.8]),
-            ..Params::gpp2()
-        };
-        let viewpoint = DVec3::new(10.0, -3.0, 1.8);
+        let (p, viewpoint) = seen_from_the_road();
         let surface = |pts: &[f32], traced_with: &Params| {
             let cloud = Cloud::from_flat(pts, 3).unwrap();
-            let policy = CascadePolicy {
-                find_risers: false,
-                ..CascadePolicy::one_shot()
-            };
             let mut det =
-                Detector::new(traced_with, policy).run(&cloud.points, cloud.origin, viewpoint);
+                Detector::new(traced_with, no_risers()).run(&cloud.points, cloud.origin, viewpoint);
             assert_eq!(det.primitives.len(), 1);
             det.primitives.remove(0)
         };
@@ -1367,23 +1380,10 @@ mod tests {
         // say its cluster left out the rows between the road and the
         // sidewalk, which fill the step. They are the wall's foot, inside
         // its outline: no riser over it.
-        let mut pts = curb(0.15, 0);
-        for i in 0..200 {
-            for j in 0..=100 {
-                pts.extend([i as f32 * 0.1 + 0.05, 0.0, j as f32 * 0.05]);
-            }
-        }
+        let pts = [curb(0.15, 0), wall(200)].concat();
         let cloud = Cloud::from_flat(&pts, 3).unwrap();
-        let p = Params {
-            viewpoint: Some([10.0, -3.0, 1.8]),
-            ..Params::gpp2()
-        };
-        let viewpoint = DVec3::new(10.0, -3.0, 1.8);
-        let policy = CascadePolicy {
-            find_risers: false,
-            ..CascadePolicy::one_shot()
-        };
-        let mut det = Detector::new(&p, policy).run(&cloud.points, cloud.origin, viewpoint);
+        let (p, viewpoint) = seen_from_the_road();
+        let mut det = Detector::new(&p, no_risers()).run(&cloud.points, cloud.origin, viewpoint);
         let wall = det
             .primitives
             .iter()
@@ -1418,63 +1418,77 @@ mod tests {
         // its support. The riser runs the curb's length, most of its points
         // beyond the wall: it is not added over the wall's foot (two
         // polygons on one plane, one over the other) but taken into the
-        // wall, which now runs on along the curb.
+        // wall, which now runs on along the curb. A wall 0.3 m behind the
+        // curb's line, or one on it from 1 m up (its outline does not meet
+        // the riser's), leaves the riser a primitive of its own.
         let ground = curb(0.15, 0);
-        let mut wall_pts: Vec<f32> = Vec::new();
-        for i in 0..50 {
-            for j in 0..=100 {
-                wall_pts.extend([i as f32 * 0.1 + 0.05, 0.0, j as f32 * 0.05]);
-            }
-        }
         let face = &curb(0.15, 400)[ground.len()..];
-        let all: Vec<f32> = [&ground[..], face, &wall_pts[..]].concat();
-        let p = Params {
-            viewpoint: Some([10.0, -3.0, 1.8]),
-            ..Params::gpp2()
-        };
-        let viewpoint = DVec3::new(10.0, -3.0, 1.8);
-        let policy = CascadePolicy {
-            find_risers: false,
-            ..CascadePolicy::one_shot()
-        };
-        let cloud = Cloud::from_flat(&all, 3).unwrap();
+        let (p, viewpoint) = seen_from_the_road();
         let detect = |pts: &[f32]| {
             let c = Cloud::from_flat(pts, 3).unwrap();
-            Detector::new(&p, policy).run(&c.points, c.origin, viewpoint)
+            Detector::new(&p, no_risers()).run(&c.points, c.origin, viewpoint)
         };
-        let (road, wall) = (detect(&ground), detect(&wall_pts));
-        assert_eq!((road.primitives.len(), wall.primitives.len()), (2, 1));
-        let mut prims = road.primitives.clone();
-        prims.extend(wall.primitives.iter().cloned());
-        let mut labels = road.labels.clone();
-        labels.extend(std::iter::repeat_n(NO_PRIMITIVE, face.len() / 3));
-        for k in 0..wall_pts.len() / 3 {
-            let low = wall_pts[3 * k + 2] < 0.14;
-            labels.push(if low { NO_PRIMITIVE } else { 2 });
-        }
+        let road = detect(&ground);
+        assert_eq!(road.primitives.len(), 2);
         let reach = |q: &crate::primitive::Primitive| {
             q.vertices().iter().map(|v| v.x).fold(f64::MIN, f64::max)
         };
-        let area = prims[2].area;
-        assert!(reach(&prims[2]) < 5.5);
-        super::add_risers(
-            &mut prims,
-            &mut labels,
-            &cloud.points,
-            cloud.origin,
-            viewpoint,
-            &p,
-            None,
-        );
+        let run = |wall_pts: &[f32]| {
+            let all: Vec<f32> = [&ground[..], face, wall_pts].concat();
+            let cloud = Cloud::from_flat(&all, 3).unwrap();
+            let wall = detect(wall_pts);
+            assert_eq!(wall.primitives.len(), 1);
+            let mut prims = road.primitives.clone();
+            prims.extend(wall.primitives.iter().cloned());
+            let mut labels = road.labels.clone();
+            labels.extend(std::iter::repeat_n(NO_PRIMITIVE, face.len() / 3));
+            for (k, &l) in wall.labels.iter().enumerate() {
+                let low = wall_pts[3 * k + 2] < 0.14;
+                if l == 0 && low {
+                    prims[2].support -= 1;
+                }
+                labels.push(if l == 0 && !low { 2 } else { NO_PRIMITIVE });
+            }
+            let before = prims[2].clone();
+            assert!(reach(&before) < 5.5);
+            super::add_risers(
+                &mut prims,
+                &mut labels,
+                &cloud.points,
+                cloud.origin,
+                viewpoint,
+                &p,
+                None,
+            );
+            for (k, q) in prims.iter().enumerate() {
+                let n = labels.iter().filter(|&&l| l == k as u32).count() as u64;
+                assert_eq!(q.support, n, "primitive {k}");
+            }
+            (prims, labels, cloud, before)
+        };
+        let (prims, labels, cloud, before) = run(&wall(50));
         assert_eq!(prims.len(), 3);
         assert!(reach(&prims[2]) > 19.5, "{}", reach(&prims[2]));
-        assert!(prims[2].area > area + 1.0, "{} -> {}", area, prims[2].area);
-        let face = (0..cloud.len()).filter(|&i| {
+        assert!(prims[2].area > before.area + 1.0);
+        let face_at = |i: usize| {
             let w = cloud.world(i);
             w.y == 0.0 && w.x > 6.0 && w.z > 0.01 && w.z < 0.14
-        });
-        assert!(face.clone().count() > 200);
-        assert!(face.into_iter().all(|i| labels[i] == 2));
+        };
+        assert!((0..cloud.len()).filter(|&i| face_at(i)).count() > 200);
+        assert!((0..cloud.len())
+            .filter(|&i| face_at(i))
+            .all(|i| labels[i] == 2));
+        let moved = |dy: f32, from_z: f32| -> Vec<f32> {
+            let w = wall(50);
+            let keep = |c: &[f32]| c[2] >= from_z;
+            let rows = w.chunks_exact(3).filter(|c| keep(c));
+            rows.flat_map(|c| [c[0], c[1] + dy, c[2]]).collect()
+        };
+        for (what, pts) in [("behind", moved(0.3, 0.15)), ("up", moved(0.0, 1.0))] {
+            let (prims, _, _, before) = run(&pts);
+            assert_eq!(prims.len(), 4, "a wall {what}");
+            assert_eq!(prims[2].area, before.area, "a wall {what}");
+        }
     }
 
     #[test]

@@ -794,7 +794,9 @@ mod tests {
     /// extended passes through the sidewalk: the sidewalk's outline lies
     /// within `mergeDistance` of that plane, but the strip's does not lie
     /// on the sidewalk's, and they stay apart. Two level pieces of about
-    /// one size that touch still merge.
+    /// one size that touch still merge, and so does a piece leaning 3
+    /// degrees beside one four times its size, on whose plane it lies
+    /// though the larger one's outline is far off its own.
     #[test]
     fn a_leaning_strip_and_a_piece_of_its_size_a_curb_up_stay_apart() {
         let p = Params::gpp2();
@@ -816,16 +818,21 @@ mod tests {
         let sidewalk = grid((3.4, 5.6), &|_| 0.15);
         let (prims, _, _) = two(&strip, &sidewalk, &p);
         assert!(prims[0].area < 2.0 * prims[1].area);
-        // The sidewalk's outline on the strip's plane, by the RMS distance.
-        let v = prims[1].vertices();
-        let ms = v
-            .iter()
-            .map(|&q| prims[0].plane.signed_distance(q).powi(2))
-            .sum::<f64>();
-        assert!((ms / v.len() as f64).sqrt() < p.merge_distance);
+        // The sidewalk on the strip's plane, by the RMS distance.
+        let on =
+            |a: &Primitive, b: &Primitive| crate::merge::mean_square(&a.vertices(), a, b).sqrt();
+        assert!(on(&prims[1], &prims[0]) < p.merge_distance);
         assert!(!mergeable(&prims[0], &prims[1], &p));
         let (a, b) = (grid((0.0, 3.9), &|_| 0.0), grid((4.0, 6.0), &|_| 0.0));
         let (prims, _, _) = two(&a, &b, &p);
+        assert!(mergeable(&prims[0], &prims[1], &p));
+        let lean = 3f64.to_radians().tan();
+        let road = grid((-6.0, 2.0), &|_| 0.0);
+        let piece = grid((2.0, 4.0), &|u| lean * (u - 2.0));
+        let (prims, _, _) = two(&road, &piece, &p);
+        assert!(prims[0].area > 3.5 * prims[1].area);
+        assert!(on(&prims[1], &prims[0]) < p.merge_distance);
+        assert!(on(&prims[0], &prims[1]) > p.layer_distance());
         assert!(mergeable(&prims[0], &prims[1], &p));
     }
 }
