@@ -62,10 +62,10 @@ pub fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
     // higher) merge in; a maximum would keep a slightly tilted piece apart
     // forever.
     let (av, bv) = (a.vertices(), b.vertices());
-    let (big, small, small_v) = if a.area >= b.area {
-        (a, b, &bv)
+    let (big, big_v, small, small_v) = if a.area >= b.area {
+        (a, &av, b, &bv)
     } else {
-        (b, a, &av)
+        (b, &bv, a, &av)
     };
     let mut ms = mean_square(small_v, small, big);
     // Two pieces of about one size: neither plane is the better reference
@@ -73,7 +73,6 @@ pub fn mergeable(a: &Primitive, b: &Primitive, params: &Params) -> bool {
     // fix, and extended over a piece beside it, such a plane can pass
     // through a surface a curb higher), so each is judged on the other's.
     if big.area < 2.0 * small.area {
-        let big_v = if std::ptr::eq(big, a) { &av } else { &bv };
         ms = ms.max(mean_square(big_v, big, small));
     }
     // Or each centroid on the other's plane (two slightly tilted pieces of
