@@ -316,7 +316,26 @@ impl Shaped {
     /// surfaces: the median over those patches of their points' RMS
     /// distance from their own PCA plane (`None` when no patch has a
     /// normal).
-    pub fn consistency(&self, origin: DVec3, pts: &[Vec3], params: &Params) -> (f64, Option<f64>) {
+    ///
+    /// A patch whose own plane passes through one of `sensors` (within two
+    /// inlier distances) holds a single laser ring, whose points lie on
+    /// that beam's cone whatever the surface: its normal is the cone's, and
+    /// its spread is not the surface's noise (near zero when the range
+    /// noise lies along the beam). Such patches count only when the support
+    /// has no other patch with a normal. Where rings lie farther apart than
+    /// a patch (sparse sensors, far ground), most patches are rings; their
+    /// spread of micrometres made the noise band of the dominant-layer test
+    /// too thin to find any layer, and their cones' normals outvoted the
+    /// few patches that saw the surface. A support seen only as lone rings
+    /// is still judged on them: a plane through one ring is no evidence of
+    /// a surface, and their cones rarely agree with it.
+    pub fn consistency(
+        &self,
+        origin: DVec3,
+        pts: &[Vec3],
+        params: &Params,
+        sensors: &[DVec3],
+    ) -> (f64, Option<f64>) {
         normal_consistency(
             origin,
             pts,
@@ -324,6 +343,11 @@ impl Shaped {
             &self.kept,
             &self.primitive.frame,
             2.0 * params.other.cell,
+            |normal: DVec3, at: DVec3| {
+                sensors
+                    .iter()
+                    .any(|&v| normal.dot(v - at).abs() < 2.0 * params.other.distance)
+            },
         )
     }
 }
@@ -451,6 +475,7 @@ fn normal_consistency(
     kept: &[bool],
     frame: &Frame,
     cell: f64,
+    one_ring: impl Fn(DVec3, DVec3) -> bool,
 ) -> (f64, Option<f64>) {
     // Large supports are judged on an even-strided subsample of 100k points.
     let step = pts.len().div_ceil(100_000).max(1);
@@ -475,8 +500,9 @@ fn normal_consistency(
         }
         cells[c as usize].push(w);
     }
-    let (mut good, mut total) = (0usize, 0usize);
-    let mut noise: Vec<f64> = Vec::new();
+    // (agreeing, with a normal, their noise): the patches of the surface
+    // itself, and those of single laser rings.
+    let mut tally: [(usize, usize, Vec<f64>); 2] = Default::default();
     let cos_max = libm::cos(15f64.to_radians());
     for m in &cells {
         if m.count < 6.0 {
@@ -491,10 +517,13 @@ fn normal_consistency(
         if vals[2] <= 0.0 || vals[1] < 0.05 * vals[2] {
             continue;
         }
-        total += 1;
-        good += (normal.dot(frame.normal).abs() >= cos_max) as usize;
-        noise.push(vals[0].max(0.0).sqrt());
+        let t = &mut tally[one_ring(normal, m.mean()) as usize];
+        t.0 += (normal.dot(frame.normal).abs() >= cos_max) as usize;
+        t.1 += 1;
+        t.2.push(vals[0].max(0.0).sqrt());
     }
+    let [own, rings] = tally;
+    let (good, total, mut noise) = if own.1 > 0 { own } else { rings };
     let mid = noise.len() / 2;
     let median = (!noise.is_empty()).then(|| *noise.select_nth_unstable_by(mid, f64::total_cmp).1);
     if total == 0 {
@@ -659,6 +688,72 @@ pub(crate) fn shape(
 mod tests {
     use super::*;
     use crate::geometry::polygon::is_simple;
+
+    /// The patches of a support on level ground (z = 0) seen from a sensor
+    /// 1.8 m above the origin: one laser ring at -20 degrees (range noise
+    /// of 5 cm along each beam, so each patch of it is two-dimensional)
+    /// and, with `surface`, a 3 x 3 m patch of ground seen densely (5 mm
+    /// of noise across it) 9-12 m away. Consistency and noise with the
+    /// sensor known and without it.
+    fn ring_patches(surface: bool) -> [(f64, Option<f64>); 2] {
+        let mut rng = crate::rng::Rng::new(3);
+        let sensor = DVec3::new(0.0, 0.0, 1.8);
+        let elevation = (-20f64).to_radians();
+        let range = 1.8 / elevation.sin().abs();
+        let mut world: Vec<DVec3> = (0..300)
+            .map(|i| {
+                let azimuth = (i as f64 * 0.2).to_radians();
+                let dir = DVec3::new(
+                    azimuth.cos() * elevation.cos(),
+                    azimuth.sin() * elevation.cos(),
+                    elevation.sin(),
+                );
+                sensor + dir * (range + 0.05 * rng.gaussian())
+            })
+            .collect();
+        if surface {
+            for i in 0..30 {
+                for j in 0..30 {
+                    let (x, y) = (9.0 + 0.1 * i as f64, 0.1 * j as f64);
+                    world.push(DVec3::new(x, y, 0.005 * rng.gaussian()));
+                }
+            }
+        }
+        let plane = Plane::from_point_normal(DVec3::ZERO, DVec3::Z);
+        let frame = Frame::on_plane(&plane, DVec3::ZERO);
+        let q: Vec<DVec2> = world.iter().map(|&w| frame.to_local(w)).collect();
+        let pts: Vec<Vec3> = world.iter().map(|w| w.as_vec3()).collect();
+        let kept = vec![true; pts.len()];
+        let params = Params::gpp2();
+        [vec![sensor], vec![]].map(|sensors| {
+            normal_consistency(DVec3::ZERO, &pts, &q, &kept, &frame, 0.4, |n, at| {
+                sensors
+                    .iter()
+                    .any(|&v: &DVec3| n.dot(v - at).abs() < 2.0 * params.other.distance)
+            })
+        })
+    }
+
+    #[test]
+    fn patches_of_a_single_laser_ring_count_only_when_nothing_else_does() {
+        // With a patch of the surface itself, the ring's patches (their
+        // planes through the sensor, leaning 20 degrees with the beam's
+        // cone) neither vote nor give the noise.
+        let [(known, noise), (unknown, _)] = ring_patches(true);
+        assert_eq!(known, 1.0);
+        let noise = noise.unwrap();
+        assert!((0.003..0.007).contains(&noise), "noise {noise}");
+        assert!(
+            unknown < 0.9,
+            "without the sensor the rings vote: {unknown}"
+        );
+        // Seen only as a ring, the support is judged on its patches as
+        // before: their cones disagree with a plane through them.
+        let [(known, noise), (unknown, _)] = ring_patches(false);
+        assert_eq!(known, unknown);
+        assert!(known < 0.5, "{known}");
+        assert!(noise.unwrap() < 0.001, "{noise:?}");
+    }
 
     /// A curb's face as the riser step makes it: the 15 cm rectangle over
     /// x in [0, 3] (frame coordinates: x along the curb, y up), with its

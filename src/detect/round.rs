@@ -218,7 +218,7 @@ impl Judge<'_> {
         let patches = shaped
             .as_ref()
             .filter(cheap_ok)
-            .map(|s| s.consistency(self.origin, support_pts, p));
+            .map(|s| s.consistency(self.origin, support_pts, p, self.ring_sensors()));
         let smooth = shaped
             .as_ref()
             .is_some_and(|s| s.roughness <= p.max_roughness);
@@ -232,6 +232,17 @@ impl Judge<'_> {
             only_too_rough: !smooth && rest,
             noise: patches.and_then(|(_, noise)| noise),
             maybe_two: smooth && rest && !tight,
+        }
+    }
+
+    /// The sensors whose single laser rings the consistency test knows by
+    /// their plane (the viewpoint, or an accumulated cloud's sensors); none
+    /// for a cloud seen from no known position.
+    fn ring_sensors(&self) -> &[DVec3] {
+        if self.policy.reject_edge_on_candidates {
+            self.edge_on_from
+        } else {
+            &[]
         }
     }
 
