@@ -236,12 +236,12 @@ impl Judge<'_> {
     }
 
     /// The sensor whose single laser rings the consistency test knows by
-    /// their plane: the viewpoint of a cloud seen from one position (a scan,
-    /// or the scenario's scan with its pool, whose earlier points lie off
-    /// this scan's cones). None for a cloud seen from no known position, or
-    /// gathered from several: there a patch through one sensor can also
-    /// hold points of other scans, off that sensor's cones (with the
-    /// scans' positions the bench's street locations lost 0.007 of recall).
+    /// their plane: the one viewpoint of a cloud seen from one position (a
+    /// scan, or the scenario's scan with its pool, whose earlier points lie
+    /// off this scan's cones; a map given one viewpoint is taken as seen
+    /// from there). No sensor for a cloud seen from no known position, or
+    /// from several (`--poses`): there a patch through one sensor can also
+    /// hold other scans' points, off that sensor's cones.
     fn ring_sensors(&self) -> &[DVec3] {
         if self.policy.reject_edge_on_candidates && self.edge_on_from.len() == 1 {
             self.edge_on_from
