@@ -701,8 +701,8 @@ mod tests {
     /// (range noise of 5 cm along each beam, so each patch of it is
     /// two-dimensional) and, with `surface`, a 1.2 x 1.2 m patch of ground
     /// seen densely (5 mm of noise across it) 9 m away: the ring's patches
-    /// outnumber the surface's four to one. Consistency and noise with the
-    /// sensor known and without it.
+    /// outnumber the surface's. Consistency and noise with the sensor known
+    /// and without it.
     fn ring_patches(surface: bool) -> [(f64, Option<f64>); 2] {
         let mut rng = crate::rng::Rng::new(3);
         let sensor = DVec3::new(0.0, 0.0, 1.8);
