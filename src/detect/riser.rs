@@ -393,9 +393,11 @@ pub(crate) fn add_risers(
                 let w = origin + pts[i as usize].as_dvec3();
                 q.plane.signed_distance(w).abs() <= p.other.distance
             };
+            if 2 * points.iter().filter(on).count() <= points.len() {
+                return false;
+            }
             let ring: Vec<DVec2> = rv.iter().map(|&v| q.frame.to_local(v)).collect();
-            2 * points.iter().filter(on).count() > points.len()
-                && rings_within(&q.outline, &ring, 0.0)
+            rings_within(&q.outline, &ring, 0.0)
         });
         if part_of.is_none() && primitives.len() >= p.max_primitives {
             // No room for it; a later one may still be taken into a
