@@ -329,14 +329,15 @@ impl Shaped {
     /// the dominant-layer test's noise band too thin to find any layer. A
     /// support seen only as lone rings is judged on them: a plane through
     /// one ring is no evidence of a surface, and their cones rarely agree
-    /// with it.
+    /// with it. The plane is then unproven ([`Consistency::rings_only`]): any
+    /// two rings lie in one plane.
     pub fn consistency(
         &self,
         origin: DVec3,
         pts: &[Vec3],
         params: &Params,
         sensors: &[DVec3],
-    ) -> (f64, Option<f64>) {
+    ) -> Consistency {
         normal_consistency(
             origin,
             pts,
@@ -474,6 +475,35 @@ fn one_laser_ring(normal: DVec3, at: DVec3, sensors: &[DVec3], params: &Params) 
         .any(|&v| normal.dot(v - at).abs() < 2.0 * params.other.distance)
 }
 
+/// What [`Shaped::consistency`] found in a support's patches.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Consistency {
+    /// Share of the patches with a normal whose normal lies within 15
+    /// degrees of the plane's (1 when no patch has one).
+    pub(crate) share: f64,
+    /// The noise of the support's surfaces: the median over those patches
+    /// of their points' RMS distance from their own planes. For a support
+    /// seen only as single laser rings ([`Consistency::rings_only`]), the
+    /// median over the rings of their points' RMS spread along the plane's
+    /// normal instead, about each ring's centroid: a ring's spread off its
+    /// laser's cone is not the surface's (micrometres when the range noise
+    /// lies along the beam). `None` when no patch has a normal.
+    pub(crate) noise: Option<f64>,
+    /// Every patch with a normal is a single laser ring: the plane was put
+    /// through rings, any two of which lie in one plane (a road's ring and
+    /// the sidewalk's beyond it, a curb up, under a plane tilted by a
+    /// degree), and no patch sees the surface.
+    pub(crate) rings_only: bool,
+}
+
+/// The variance along unit `n` of points with covariance `c`.
+fn along(c: [[f64; 3]; 3], n: DVec3) -> f64 {
+    let n = n.to_array();
+    (0..3)
+        .map(|i| (0..3).map(|j| n[i] * c[i][j] * n[j]).sum::<f64>())
+        .sum()
+}
+
 /// See [`Shaped::consistency`].
 fn normal_consistency(
     origin: DVec3,
@@ -483,7 +513,7 @@ fn normal_consistency(
     frame: &Frame,
     cell: f64,
     one_ring: impl Fn(DVec3, DVec3) -> bool,
-) -> (f64, Option<f64>) {
+) -> Consistency {
     // Large supports are judged on an even-strided subsample of 100k points.
     let step = pts.len().div_ceil(100_000).max(1);
     let chosen: Vec<usize> = (0..pts.len()).step_by(step).filter(|&i| kept[i]).collect();
@@ -524,19 +554,33 @@ fn normal_consistency(
         if vals[2] <= 0.0 || vals[1] < 0.05 * vals[2] {
             continue;
         }
-        let t = &mut tally[one_ring(normal, m.mean()) as usize];
+        let ring = one_ring(normal, m.mean());
+        // A ring's spread off its own plane (its laser's cone) is not the
+        // surface's; along the plane's normal, about the ring's centroid,
+        // it is what the surface shows there.
+        let spread = if ring {
+            along(m.covariance(), frame.normal)
+        } else {
+            vals[0]
+        };
+        let t = &mut tally[ring as usize];
         t.0 += (normal.dot(frame.normal).abs() >= cos_max) as usize;
         t.1 += 1;
-        t.2.push(vals[0].max(0.0).sqrt());
+        t.2.push(spread.max(0.0).sqrt());
     }
     let [own, rings] = tally;
+    let rings_only = own.1 == 0 && rings.1 > 0;
     let (good, total, mut noise) = if own.1 > 0 { own } else { rings };
     let mid = noise.len() / 2;
     let median = (!noise.is_empty()).then(|| *noise.select_nth_unstable_by(mid, f64::total_cmp).1);
-    if total == 0 {
-        (1.0, None)
-    } else {
-        (good as f64 / total as f64, median)
+    Consistency {
+        share: if total == 0 {
+            1.0
+        } else {
+            good as f64 / total as f64
+        },
+        noise: median,
+        rings_only,
     }
 }
 
@@ -701,9 +745,9 @@ mod tests {
     /// (range noise of 5 cm along each beam, so each patch of it is
     /// two-dimensional) and, with `surface`, a 1.2 x 1.2 m patch of ground
     /// seen densely (5 mm of noise across it) 9 m away: the ring's patches
-    /// outnumber the surface's. Consistency and noise with the sensor known
+    /// outnumber the surface's. The test's findings with the sensor known
     /// and without it.
-    fn ring_patches(surface: bool) -> [(f64, Option<f64>); 2] {
+    fn ring_patches(surface: bool) -> [Consistency; 2] {
         let mut rng = crate::rng::Rng::new(3);
         let sensor = DVec3::new(0.0, 0.0, 1.8);
         let elevation = (-20f64).to_radians();
@@ -745,22 +789,29 @@ mod tests {
         // With patches of the surface itself, the ring's patches (their
         // planes through the sensor, leaning 20 degrees with the laser's
         // cone) neither vote nor give the noise.
-        let [(known, noise), (unknown, noise_unknown)] = ring_patches(true);
-        assert_eq!(known, 1.0);
-        let noise = noise.unwrap();
+        let [known, unknown] = ring_patches(true);
+        assert_eq!(known.share, 1.0);
+        assert!(!known.rings_only);
+        let noise = known.noise.unwrap();
         assert!((0.003..0.007).contains(&noise), "noise {noise}");
         assert!(
-            unknown < 0.5,
-            "without the sensor the rings vote: {unknown}"
+            unknown.share < 0.5,
+            "without the sensor the rings vote: {unknown:?}"
         );
-        let noise_unknown = noise_unknown.unwrap();
+        let noise_unknown = unknown.noise.unwrap();
         assert!(noise_unknown < 0.001, "and give the noise: {noise_unknown}");
         // Seen only as a ring, the support is judged on its patches as
-        // before: their cones disagree with a plane through them.
-        let [(known, noise), (unknown, _)] = ring_patches(false);
-        assert_eq!(known, unknown);
-        assert!(known < 0.5, "{known}");
-        assert!(noise.unwrap() < 0.001, "{noise:?}");
+        // before: their cones disagree with a plane through them. The
+        // plane is unproven, and the noise is the ring's spread along the
+        // plane's normal: 5 cm of range noise at 20 degrees below level
+        // moves a point 1.7 cm up or down.
+        let [known, unknown] = ring_patches(false);
+        assert_eq!(known.share, unknown.share);
+        assert!(known.share < 0.5, "{known:?}");
+        assert!(known.rings_only && !unknown.rings_only);
+        let noise = known.noise.unwrap();
+        assert!((0.013..0.021).contains(&noise), "noise {noise}");
+        assert!(unknown.noise.unwrap() < 0.001, "{unknown:?}");
     }
 
     /// A curb's face as the riser step makes it: the 15 cm rectangle over

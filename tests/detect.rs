@@ -1814,3 +1814,76 @@ fn a_map_s_sparse_far_surfaces_are_found_at_a_coarser_scale() {
         "precision {with:?} against {without:?}"
     );
 }
+
+/// Laser rings of a sensor 1.8 m above a road, over the half turn to its
+/// right, with a sidewalk a 15 cm curb up from 3.5 m to the right: the
+/// rings of the lasers at `elevations` (degrees), each beam's range noise
+/// (1 cm) along the beam, one beam every 0.2 degrees. Points in the world
+/// frame.
+fn rings_across_a_curb(elevations: &[f64], rng: &mut Rng) -> Vec<DVec3> {
+    let sensor = DVec3::new(0.0, 0.0, 1.8);
+    let (right, curb) = (-3.5, 0.15);
+    let mut pts = Vec::new();
+    for &e in elevations {
+        let e = e.to_radians();
+        for k in 0..900 {
+            let a = (-k as f64 * 0.2).to_radians();
+            let dir = DVec3::new(e.cos() * a.cos(), e.cos() * a.sin(), e.sin());
+            // The road, unless the beam crosses the curb line first: then
+            // the curb's face below its top, or the sidewalk beyond it.
+            let mut t = -sensor.z / dir.z;
+            if t * dir.y < right {
+                let tc = right / dir.y;
+                t = if sensor.z + tc * dir.z <= curb {
+                    tc
+                } else {
+                    (curb - sensor.z) / dir.z
+                };
+            }
+            pts.push(sensor + dir * (t + 0.01 * rng.gaussian()));
+        }
+    }
+    pts
+}
+
+/// Any two laser rings lie in one plane. Where rings lie metres apart (a
+/// 16-laser sensor's far ground), a candidate can hold nothing but rings
+/// (the road's and the sidewalk's beyond a curb) under a plane tilted by a
+/// degree or two that fits both to within centimetres: every 0.4 m patch
+/// of it with a normal is a single ring. Such a plane is unproven, and is
+/// judged by its layers, its noise the rings' spread along its normal.
+/// Without that (measured), the first scan of these four far rings ends
+/// with 61 m^2 of such a slab, tilted 1.4 degrees; on the bench's 16-laser
+/// street drive one such slab merged into the road, tilting it by 0.59
+/// degrees, and scan alignment then turned the map after it (mean error
+/// 120 mm).
+#[test]
+fn laser_rings_across_a_curb_give_level_surfaces_only() {
+    let elevations = [-8.87, -10.93, -13.0, -15.0];
+    let pts = rings_across_a_curb(&elevations, &mut Rng::new(5));
+    let local: Vec<f32> = pts
+        .iter()
+        .flat_map(|p| [p.x as f32, p.y as f32, (p.z - 1.8) as f32, 0.0])
+        .collect();
+    let mut scenario = polyscene::Scenario::new(Params::gpp2()).unwrap();
+    let pose = glam::DMat4::from_translation(DVec3::new(0.0, 0.0, 1.8));
+    scenario.add_scan(&local, 4, &pose).unwrap();
+    // (A 2.4 m^2 piece no patch of which has a normal, strips one ring
+    // wide, is still kept whole, tilted 3 degrees: docs/LIMITATIONS.md.)
+    let mut level = 0.0;
+    for q in scenario.primitives().iter().filter(|q| q.area >= 5.0) {
+        let z: Vec<f64> = q.outline.iter().map(|&v| q.frame.to_world(v).z).collect();
+        let (lo, hi) = z
+            .iter()
+            .fold((f64::MAX, f64::MIN), |(l, h), &z| (l.min(z), h.max(z)));
+        let tilt = q.plane.normal.z.abs().acos().to_degrees();
+        assert!(
+            tilt < 0.2 && hi - lo < 0.03,
+            "a {:.1} m^2 polygon tilted {tilt:.2} degrees spans heights {lo:.3} to {hi:.3}",
+            q.area
+        );
+        level += q.area;
+    }
+    // Measured: a 17 m^2 piece of the sidewalk, level.
+    assert!(level > 8.0, "{level} m^2 found");
+}

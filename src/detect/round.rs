@@ -137,8 +137,10 @@ pub(crate) struct Judged {
     pub(crate) noise: Option<f64>,
     /// Accepted, but with fewer of its points within half the inlier
     /// distance than a surface as rough as `maxRoughness` allows would
-    /// have ([`least_tight_share`]): perhaps two surfaces that one plane
-    /// between them holds, smoothly enough to pass.
+    /// have ([`least_tight_share`]), or seen only as single laser rings
+    /// ([`Consistency::rings_only`](crate::primitive::Consistency)):
+    /// perhaps two surfaces that one plane between them holds, smoothly
+    /// enough to pass.
     pub(crate) maybe_two: bool,
 }
 
@@ -222,7 +224,7 @@ impl Judge<'_> {
         let smooth = shaped
             .as_ref()
             .is_some_and(|s| s.roughness <= p.max_roughness);
-        let rest = patches.is_some_and(|(c, _)| c >= p.min_normal_consistency);
+        let rest = patches.is_some_and(|c| c.share >= p.min_normal_consistency);
         let tight = shaped
             .as_ref()
             .is_some_and(|s| s.tight_share >= least_tight_share(p));
@@ -230,8 +232,10 @@ impl Judge<'_> {
             shaped,
             accepted: smooth && rest,
             only_too_rough: !smooth && rest,
-            noise: patches.and_then(|(_, noise)| noise),
-            maybe_two: smooth && rest && !tight,
+            noise: patches.and_then(|c| c.noise),
+            // A plane through single laser rings alone is unproven (any two
+            // of them lie in one): it may hold two surfaces, however tight.
+            maybe_two: smooth && rest && (!tight || patches.is_some_and(|c| c.rings_only)),
         }
     }
 
