@@ -313,9 +313,7 @@ impl Shaped {
     /// demand: it is the costliest acceptance test (a plane fit per patch),
     /// so the cascade asks for it only when every other test passed.
     /// With it, from the same patch fits, the noise of the support's
-    /// surfaces: the median over those patches of their points' RMS
-    /// distance from their own PCA plane (`None` when no patch has a
-    /// normal).
+    /// surfaces ([`Consistency::noise`]).
     ///
     /// A patch whose own plane passes through one of `sensors`
     /// ([`one_laser_ring`]) holds a single laser ring, whose points lie on
@@ -329,8 +327,8 @@ impl Shaped {
     /// the dominant-layer test's noise band too thin to find any layer. A
     /// support seen only as lone rings is judged on them: a plane through
     /// one ring is no evidence of a surface, and their cones rarely agree
-    /// with it. The plane is then unproven ([`Consistency::rings_only`]): any
-    /// two rings lie in one plane.
+    /// with it. The plane is then unproven ([`Consistency::rings_only`]): two
+    /// ring arcs metres apart fit one plane within centimetres.
     pub fn consistency(
         &self,
         origin: DVec3,
@@ -479,7 +477,8 @@ fn one_laser_ring(normal: DVec3, at: DVec3, sensors: &[DVec3], params: &Params) 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Consistency {
     /// Share of the patches with a normal whose normal lies within 15
-    /// degrees of the plane's (1 when no patch has one).
+    /// degrees of the plane's, single laser rings left out unless only
+    /// they have one (1 when no patch has one).
     pub(crate) share: f64,
     /// The noise of the support's surfaces: the median over those patches
     /// of their points' RMS distance from their own planes. For a support
@@ -490,9 +489,10 @@ pub(crate) struct Consistency {
     /// lies along the beam). `None` when no patch has a normal.
     pub(crate) noise: Option<f64>,
     /// Every patch with a normal is a single laser ring: the plane was put
-    /// through rings, any two of which lie in one plane (a road's ring and
-    /// the sidewalk's beyond it, a curb up, under a plane tilted by a
-    /// degree), and no patch sees the surface.
+    /// through rings, and two ring arcs metres apart fit one plane within
+    /// centimetres (a road's ring and the sidewalk's beyond it, a curb up,
+    /// under a plane tilted by a degree or two): no patch sees the
+    /// surface.
     pub(crate) rings_only: bool,
 }
 
@@ -800,8 +800,8 @@ mod tests {
         );
         let noise_unknown = unknown.noise.unwrap();
         assert!(noise_unknown < 0.001, "and give the noise: {noise_unknown}");
-        // Seen only as a ring, the support is judged on its patches as
-        // before: their cones disagree with a plane through them. The
+        // Seen only as a ring, the support is judged on its patches: their
+        // cones disagree with a plane through them. The
         // plane is unproven, and the noise is the ring's spread along the
         // plane's normal: 5 cm of range noise at 20 degrees below level
         // moves a point 1.7 cm up or down.

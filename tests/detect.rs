@@ -1846,7 +1846,8 @@ fn rings_across_a_curb(elevations: &[f64], rng: &mut Rng) -> Vec<DVec3> {
     pts
 }
 
-/// Any two laser rings lie in one plane. Where rings lie metres apart (a
+/// Two laser ring arcs metres apart fit one plane within centimetres.
+/// Where rings lie metres apart (a
 /// 16-laser sensor's far ground), a candidate can hold nothing but rings
 /// (the road's and the sidewalk's beyond a curb) under a plane tilted by a
 /// degree or two that fits both to within centimetres: every 0.4 m patch
@@ -1876,7 +1877,7 @@ fn laser_rings_across_a_curb_give_level_surfaces_only() {
         let (lo, hi) = z
             .iter()
             .fold((f64::MAX, f64::MIN), |(l, h), &z| (l.min(z), h.max(z)));
-        let tilt = q.plane.normal.z.abs().acos().to_degrees();
+        let tilt = q.plane.normal.z.abs().min(1.0).acos().to_degrees();
         assert!(
             tilt < 0.2 && hi - lo < 0.03,
             "a {:.1} m^2 polygon tilted {tilt:.2} degrees spans heights {lo:.3} to {hi:.3}",

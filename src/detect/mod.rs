@@ -524,7 +524,8 @@ impl<'p> Detector<'p> {
                         step.area = judged.shaped.as_ref().map_or(0.0, |s| s.primitive.area);
                     }
                     // Too rough, nothing else wrong, or smooth enough but
-                    // not tight: perhaps two surfaces that one plane holds
+                    // not tight or seen only as laser rings: perhaps two
+                    // surfaces that one plane holds
                     // (a step, a bend, a road and a sidewalk under a tilted
                     // plane). Judge the dominant one alone; the rest of the
                     // cluster stays in play. (When it fails, a rough

@@ -65,7 +65,8 @@ pub struct CascadePolicy {
     /// [`HullKind`](crate::params::HullKind)).
     pub merge_pieces: bool,
     /// A candidate that fails only the roughness test, or passes it with
-    /// fewer of its points near its plane than a surface has, is often two
+    /// fewer of its points near its plane than a surface has or seen only
+    /// as single laser rings (from one known sensor), is often two
     /// surfaces that one plane holds within the inlier distance: a road and
     /// a plaza 10 cm higher (two parallel layers with a gap between them), a
     /// road and the sidewalk a curb above it under a plane tilted to hold

@@ -233,8 +233,9 @@ impl Judge<'_> {
             accepted: smooth && rest,
             only_too_rough: !smooth && rest,
             noise: patches.and_then(|c| c.noise),
-            // A plane through single laser rings alone is unproven (any two
-            // of them lie in one): it may hold two surfaces, however tight.
+            // A plane through single laser rings alone is unproven (two
+            // ring arcs metres apart fit one within centimetres): it may
+            // hold two surfaces, however tight.
             maybe_two: smooth && rest && (!tight || patches.is_some_and(|c| c.rings_only)),
         }
     }
