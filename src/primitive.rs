@@ -463,14 +463,22 @@ impl Shaped {
     }
 }
 
+/// Does a plane at signed distance `d` from the viewpoint pass through it
+/// (within two inlier distances)? Every ray from the sensor to such a plane
+/// grazes it. The test of the RANSAC hypotheses, of the candidates (the
+/// edge-on rules, module `detect`) and of the consistency test's patches
+/// ([`one_laser_ring`]).
+pub(crate) fn through_viewpoint(d: f64, p: &Params) -> bool {
+    d.abs() < 2.0 * p.other.distance
+}
+
 /// Does a patch whose plane has `normal` and passes through `at` hold a
 /// single laser ring of a sensor at one of `sensors`: does that plane pass
-/// within twice the (non-ground) inlier distance of one, as the edge-on
-/// test asks of a candidate? A laser's cone contains its sensor.
+/// through one ([`through_viewpoint`])? A laser's cone contains its sensor.
 fn one_laser_ring(normal: DVec3, at: DVec3, sensors: &[DVec3], params: &Params) -> bool {
     sensors
         .iter()
-        .any(|&v| normal.dot(v - at).abs() < 2.0 * params.other.distance)
+        .any(|&v| through_viewpoint(normal.dot(v - at), params))
 }
 
 /// What [`Shaped::consistency`] found in a support's patches.

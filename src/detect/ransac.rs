@@ -675,7 +675,7 @@ impl PlanePool {
         let Some(near) = &mut self.near else {
             return false;
         };
-        if !super::viewpoint::through_viewpoint(plane.normal.dot(viewpoint) + plane.offset, params)
+        if !crate::primitive::through_viewpoint(plane.normal.dot(viewpoint) + plane.offset, params)
         {
             return false;
         }

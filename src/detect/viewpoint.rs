@@ -3,15 +3,8 @@
 
 use crate::geometry::polygon::{contains, distance};
 use crate::params::Params;
-use crate::primitive::Shaped;
+use crate::primitive::{through_viewpoint, Shaped};
 use glam::{DVec2, DVec3};
-
-/// Does a plane at signed distance `d` from the viewpoint pass through it
-/// (within two inlier distances)? Every ray from the sensor to such a plane
-/// grazes it. The test of both the RANSAC hypotheses and the candidates.
-pub(crate) fn through_viewpoint(d: f64, p: &Params) -> bool {
-    d.abs() < 2.0 * p.other.distance
-}
 
 /// Is this candidate a plane the sensor lies in, away from it? Its plane
 /// passes within two inlier distances of the viewpoint, so every ray to it
